@@ -1,0 +1,65 @@
+# eyestereo: FPGA stereo-vision cores in MyHDL, verified with cocotb on GHDL.
+#   make demo    the main job: real image through the generated Sobel VHDL in GHDL -> build/demo/
+#   make test    every test (unit, model, GHDL benches, synthesis checks), 2 workers
+# Both set everything up on a fresh Debian machine: .venv, the editable install, GHDL.
+
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.installed-$(shell (cat pyproject.toml 2>/dev/null || echo none) | cksum | cut -d' ' -f1)
+JOBS   ?= 2
+
+.PHONY: all setup ghdl vhdl sim test demo synth bench clean distclean help
+
+all: test
+
+help:
+	@sed -n '1,6p' Makefile
+
+setup: $(STAMP) ghdl
+
+# The stamp is keyed on pyproject.toml: editing it reinstalls, a second run does nothing.
+$(STAMP): pyproject.toml
+	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else 1)' || \
+	  { echo "error: eyestereo needs Python >= 3.11 (found $$($(PYTHON) --version 2>&1)); set PYTHON=..." >&2; exit 1; }
+	@test -x $(PY) || $(PYTHON) -m venv $(VENV) 2>/dev/null || { \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq python3-venv >/dev/null && \
+	    $(PYTHON) -m venv $(VENV); \
+	  else echo "error: cannot create a venv: install python3-venv (Debian: sudo apt-get install python3-venv)" >&2; exit 1; fi; }
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q -e '.[dev]'
+	@rm -f $(VENV)/.installed-*
+	@touch $@
+
+ghdl:
+	@command -v ghdl >/dev/null || { \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+	    echo "installing GHDL from Debian ..."; \
+	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ghdl >/dev/null; \
+	  else echo "error: GHDL is missing: install it (Debian: sudo apt-get install ghdl)" >&2; exit 1; fi; }
+
+vhdl: setup
+	$(PY) -m eyestereo.hdl.convert --out build/vhdl
+
+sim: setup
+	$(PY) -m pytest -m sim -n $(JOBS)
+
+test: setup
+	$(PY) -m pytest -n $(JOBS)
+
+demo: setup
+	$(PY) -m eyestereo.sim.demo --out build/demo
+
+synth: setup
+	$(PY) -m eyestereo.hdl.synth --out build/synth
+
+bench: setup
+	$(PY) -m eyestereo.sim.benchmark --out docs/benchmarks.md
+
+clean:
+	rm -rf build .pytest_cache .hypothesis
+	find . -name __pycache__ -type d -prune -exec rm -rf {} +
+
+distclean: clean
+	rm -rf $(VENV) *.egg-info

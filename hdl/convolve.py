@@ -1,0 +1,116 @@
+"""General NxN convolution (correlation) with constant integer kernels, separable or not (thesis 6.2.1)."""
+
+from myhdl import Signal, always, always_comb, block, intbv
+
+from eyestereo.hdl.window import _sig, _sig_range, column_taps, delay, shift_add, window_control
+from eyestereo.tools.convolve import check_kernel, output_width
+from eyestereo.tools.stream import check_geometry
+
+
+@block
+def convolve(clk, rst, sink, source, *, kernel=None, col=None, row=None, shift: int = 0,
+             width: int = 352, height: int = 288):
+    """``source`` pixel (x, y) = floor(sum k[i, j] * p(x - r + j, y - r + i) / 2**shift), r = N // 2.
+
+    The window is centred on the output pixel (correlation, no kernel flip). Give ``kernel`` (NxN) for
+    the inseparable form (N x N register window, row sums, then the total) or ``col`` and ``row``
+    (1-D, kernel = outer(col, row)) for the separable form (vertical sums of each incoming column, a
+    row of N registers, then the horizontal sum). Constant coefficients become shifts and adds.
+    Pixels whose window leaves the image carry unspecified data (border treatment option 3).
+
+    Ports:
+        clk, rst: clock and synchronous active-high reset (control only).
+        sink: ImageStream, unsigned pixels of any width up to 36 bits.
+        source: ImageStream whose data width is :func:`eyestereo.tools.convolve.output_width`
+            (two's complement when the kernel has negative coefficients).
+
+    Parameters:
+        kernel / col, row: integer coefficients, N = 3 or 5, |k| < 2**16.
+        shift: right shift (floor) applied to the sum, >= 0.
+        width, height: frame size, each at least N.
+
+    Latency: N + 2 clocks after input pixel (x + r, y + r), i.e. r lines + r pixels + N + 2 clocks.
+
+    Resources: N - 1 line delays (one RAMB16 each for width x data bits up to 512x36), adders and
+    registers; no multipliers.
+    """
+    k, separable = check_kernel(kernel, col, row)
+    n = k.shape[0]
+    r = n // 2
+    check_geometry(width, height, min_size=n)
+    if not isinstance(shift, int) or shift < 0:
+        raise ValueError(f"shift must be an int >= 0, got {shift!r}")
+    dw = len(sink.data)
+    bits, signed = output_width(k, dw, shift)
+    if len(source.data) != bits:
+        raise ValueError(f"convolve source needs {bits} data bits for this kernel and shift, has {len(source.data)}")
+
+    taps = [Signal(intbv(0)[dw:]) for _ in range(n)]
+    tap_valid = Signal(bool(0))
+    insts = [column_taps(clk, rst, sink, taps, tap_valid, width=width, height=height)]
+
+    if separable:
+        cv = [int(c) for c in col]
+        rv = [int(c) for c in row]
+        vlo = sum(min(c * 0, c * ((1 << dw) - 1)) for c in cv)
+        vhi = sum(max(c * 0, c * ((1 << dw) - 1)) for c in cv)
+        vsum = _sig(vlo, vhi)
+        vreg = _sig(vlo, vhi)
+        vvalid = Signal(bool(0))
+        insts += [shift_add(list(zip(taps, cv)), vsum), delay(clk, vsum, vreg, clocks=1),
+                  delay(clk, tap_valid, vvalid, clocks=1)]
+        hregs = [_sig(vlo, vhi) for _ in range(n)]  # hregs[0] newest = rightmost column
+        src = vreg
+        for h in hregs:
+            insts.append(en_reg(clk, vvalid, src, h))
+            src = h
+        total = _sum_sig(hregs, rv[::-1])
+        insts.append(shift_add(list(zip(hregs, rv[::-1])), total))
+    else:
+        rowsums = []
+        for i in range(n):
+            w = [Signal(intbv(0)[dw:]) for _ in range(n)]  # w[0] newest = rightmost column
+            src = taps[i]
+            for reg in w:
+                insts.append(en_reg(clk, tap_valid, src, reg))
+                src = reg
+            coeffs = [int(c) for c in k[i][::-1]]
+            rs = _sum_sig(w, coeffs)
+            rreg = _sig(*_sig_range(rs))
+            insts += [shift_add(list(zip(w, coeffs)), rs), delay(clk, rs, rreg, clocks=1)]
+            rowsums.append(rreg)
+        total = _sum_sig(rowsums, [1] * n)
+        insts.append(shift_add([(s, 1) for s in rowsums], total))
+
+    scaled = Signal(intbv(0, min=-(1 << (bits - 1)), max=1 << (bits - 1))) if signed else Signal(intbv(0)[bits:])
+
+    @always_comb
+    def scale():
+        scaled.next = total >> shift
+
+    @always(clk.posedge)
+    def outreg():
+        source.data.next = scaled[bits:]
+
+    insts += [scale, outreg,
+              window_control(clk, rst, sink, source, width=width, height=height, radius=r, latency=n + 2)]
+    return insts
+
+
+def _sum_sig(sigs, coeffs):
+    lo = hi = 0
+    for s, c in zip(sigs, coeffs):
+        a, b = _sig_range(s)
+        lo += min(a * c, b * c)
+        hi += max(a * c, b * c)
+    return _sig(lo, hi)
+
+
+@block
+def en_reg(clk, en, d, q):
+    @always(clk.posedge)
+    def reg():
+        if en:
+            q.next = d
+
+    return reg

@@ -1,0 +1,83 @@
+"""Separable 3x3 Sobel gradients Ix, Iy by shifts and adds, quantized to sfix[9,-3] (thesis 6.2.1)."""
+
+from myhdl import Signal, always, block, concat, intbv
+
+from eyestereo.hdl.convolve import en_reg
+from eyestereo.hdl.window import _sig, column_taps, delay, shift_add, window_control
+from eyestereo.tools.stream import check_geometry
+
+LATENCY = 5
+
+
+@block
+def sobel(clk, rst, sink, source, *, width: int = 352, height: int = 288):
+    """Image gradients: ``source`` pixel (x, y) = (Iy, Ix) of the 3x3 Sobel centred on input (x, y).
+
+    Ix is the response of [[-1,0,1],[-2,0,2],[-1,0,1]] (right minus left, like OpenCV's Sobel with
+    dx=1), Iy that of its transpose (down minus up). Both come from one pair of line delays: the
+    vertical pass forms the smoothed column p(y-1) + 2p(y) + p(y+1) and the difference p(y+1) - p(y-1),
+    the horizontal pass their difference (Ix) and smoothing (Iy). Each is floored to sfix[9,-3]
+    (floor(G / 8), codes -128..127 in a 9-bit two's complement field). Border pixels (x or y at the
+    image edge) carry unspecified data.
+
+    Ports:
+        clk, rst: clock and synchronous active-high reset (control only).
+        sink: ImageStream, 8-bit grey pixels.
+        source: ImageStream, 18 bits: Iy in bits 17..9, Ix in bits 8..0, two's complement.
+
+    Parameters:
+        width, height: frame size, each 3..4096.
+
+    Latency: 5 clocks after input pixel (x + 1, y + 1): 1 line + 1 pixel + 5 clocks.
+
+    Resources: 2 line delays (2 RAMB16 for width <= 2048), shift-and-add logic, no multipliers.
+    """
+    check_geometry(width, height, min_size=3)
+    if len(sink.data) != 8:
+        raise ValueError(f"sobel takes 8-bit pixels, sink has {len(sink.data)} data bits")
+    if len(source.data) != 18:
+        raise ValueError(f"sobel source carries 18 bits (Iy, Ix), has {len(source.data)}")
+
+    top, mid, bot = taps = [Signal(intbv(0)[8:]) for _ in range(3)]
+    tap_valid = Signal(bool(0))
+    insts = [column_taps(clk, rst, sink, taps, tap_valid, width=width, height=height)]
+
+    # Vertical pass, registered.
+    smooth_c, smooth = _sig(0, 1020), _sig(0, 1020)
+    diff_c, diff = _sig(-255, 255), _sig(-255, 255)
+    col_valid = Signal(bool(0))
+    insts += [shift_add([(top, 1), (mid, 2), (bot, 1)], smooth_c),
+              shift_add([(bot, 1), (top, -1)], diff_c),
+              delay(clk, smooth_c, smooth, clocks=1), delay(clk, diff_c, diff, clocks=1),
+              delay(clk, tap_valid, col_valid, clocks=1)]
+
+    # A row of three columns; index 0 is the newest (right-hand) one.
+    s = [_sig(0, 1020) for _ in range(3)]
+    d = [_sig(-255, 255) for _ in range(3)]
+    for regs, first in ((s, smooth), (d, diff)):
+        src = first
+        for reg in regs:
+            insts.append(en_reg(clk, col_valid, src, reg))
+            src = reg
+
+    gx = _sig(-1020, 1020)
+    gy = _sig(-1020, 1020)
+    insts += [shift_add([(s[0], 1), (s[2], -1)], gx),
+              shift_add([(d[0], 1), (d[1], 2), (d[2], 1)], gy)]
+
+    # floor(G / 8) in 9 bits: an arithmetic shift, then the low 9 bits of the two's complement word.
+    qx = Signal(intbv(0, min=-256, max=256))
+    qy = Signal(intbv(0, min=-256, max=256))
+
+    @always(gx, gy)
+    def quantize():
+        qx.next = gx >> 3
+        qy.next = gy >> 3
+
+    @always(clk.posedge)
+    def outreg():
+        source.data.next = concat(qy[9:], qx[9:])
+
+    insts += [quantize, outreg,
+              window_control(clk, rst, sink, source, width=width, height=height, radius=1, latency=LATENCY)]
+    return insts

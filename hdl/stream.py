@@ -1,0 +1,69 @@
+"""The image stream: the one pixel interface every eyestereo block speaks.
+
+A stream carries one frame after another in raster order (left to right, top to bottom), one pixel per
+valid beat, with no back-pressure: a block must take every valid beat in the clock it is offered. All
+signals are active high and sampled on the rising edge of ``clk``.
+
+Fields (VHDL/Verilog ports come out as ``<arg>_<field>``, e.g. ``sink_data``, ``source_valid``):
+
+``data``
+    The pixel, ``data_width`` bits, unsigned bit vector. Blocks that carry several or signed values pack
+    them into it and say how in their docstring (e.g. Sobel: ``Iy`` in bits 17..9, ``Ix`` in 8..0, two's
+    complement).
+``valid``
+    The other fields mean something only while ``valid`` is high. Idle cycles (``valid`` low) may come
+    anywhere, as many as the source likes, also inside a line.
+``eol``
+    End of line: high with the last pixel of every line.
+``eof``
+    End of frame: high together with ``eol`` on the last pixel of the frame.
+``cam``
+    Stereo streams only (``stereo=True``): which camera the beat belongs to (0 left, 1 right).
+
+Reset token: a valid beat with ``eof`` high and ``eol`` low carries no pixel. It aborts the frame in
+progress and puts a block back to its start-of-frame state; each block forwards it to its source at once,
+so one token sent after power-up initialises a whole chain. The next beat after a token is pixel (0, 0).
+
+Timing of a 4x2 frame with idle cycles, then a reset token and the next frame (``#`` high, ``_`` low,
+``.`` don't care; data shows the pixel's (x,y))::
+
+    cycle   0    1    2    3    4    5    6    7    8    9    10   11   12
+    valid   _    #    #    _    #    #    #    #    #    #    _    #    #
+    eol     .    _    _    .    _    #    _    _    _    #    .    _    _
+    eof     .    _    _    .    _    _    _    _    _    #    .    #    _
+    data    .   0,0  1,0   .   2,0  3,0  0,1  1,1  2,1  3,1   .   tok  0,0
+
+Frame geometry is fixed at elaboration (``width`` x ``height`` parameters of each block). A block's source
+emits frames of the geometry its docstring states (the sink's, for all filters), with the same
+valid/eol/eof pattern per frame, after a latency given in the block's docstring.
+"""
+
+from myhdl import Signal, intbv
+
+
+class ImageStream:
+    """A MyHDL interface bundle for one image stream (see the module docstring for the protocol).
+
+    Parameters:
+        data_width: bits of ``data`` (>= 1).
+        stereo: add the ``cam`` field.
+    """
+
+    def __init__(self, data_width: int = 8, *, stereo: bool = False):
+        if not isinstance(data_width, int) or data_width < 1:
+            raise ValueError(f"ImageStream data_width must be an int >= 1, got {data_width!r}")
+        self.data_width = data_width
+        self.stereo = stereo
+        self.data = Signal(intbv(0)[data_width:])
+        self.valid = Signal(bool(0))
+        self.eol = Signal(bool(0))
+        self.eof = Signal(bool(0))
+        if stereo:
+            self.cam = Signal(bool(0))
+
+    def fields(self) -> list[str]:
+        """Names of the signal fields, in port order."""
+        return ["data", "valid", "eol", "eof"] + (["cam"] if self.stereo else [])
+
+    def __repr__(self) -> str:
+        return f"ImageStream(data_width={self.data_width}, stereo={self.stereo})"

@@ -1,0 +1,1 @@
+"""cocotb benches and the GHDL runner helper."""

@@ -1,0 +1,1 @@
+"""Bit-true models, fixed point and software tools (numpy/OpenCV only)."""
