@@ -1,9 +1,11 @@
 """General NxN convolution (correlation) with constant integer kernels, separable or not (thesis 6.2.1)."""
 
+import numpy as np
 from myhdl import Signal, always, always_comb, block, intbv
 
 from eyestereo.hdl.window import _sig, _sig_range, column_taps, delay, shift_add, window_control
-from eyestereo.tools.convolve import check_kernel, output_width
+from eyestereo.hdl.fixed import fx_signal
+from eyestereo.tools.convolve import check_kernel, output_format
 from eyestereo.tools.stream import check_geometry
 
 
@@ -38,10 +40,12 @@ def convolve(clk, rst, sink, source, *, kernel=None, col=None, row=None, shift: 
     n = k.shape[0]
     r = n // 2
     check_geometry(width, height, min_size=n)
-    if not isinstance(shift, int) or shift < 0:
+    if isinstance(shift, bool) or not isinstance(shift, (int, np.integer)) or shift < 0:
         raise ValueError(f"shift must be an int >= 0, got {shift!r}")
     dw = len(sink.data)
-    bits, signed = output_width(k, dw, shift)
+    shift = int(shift)
+    fmt = output_format(k, dw, shift)
+    bits = fmt.wl
     if len(source.data) != bits:
         raise ValueError(f"convolve source needs {bits} data bits for this kernel and shift, has {len(source.data)}")
 
@@ -50,8 +54,8 @@ def convolve(clk, rst, sink, source, *, kernel=None, col=None, row=None, shift: 
     insts = [column_taps(clk, rst, sink, taps, tap_valid, width=width, height=height)]
 
     if separable:
-        cv = [int(c) for c in col]
-        rv = [int(c) for c in row]
+        cv = [int(c) for c in np.asarray(col, dtype=np.int64)]  # integral: checked by check_kernel
+        rv = [int(c) for c in np.asarray(row, dtype=np.int64)]
         vlo = sum(min(c * 0, c * ((1 << dw) - 1)) for c in cv)
         vhi = sum(max(c * 0, c * ((1 << dw) - 1)) for c in cv)
         vsum = _sig(vlo, vhi)
@@ -82,7 +86,7 @@ def convolve(clk, rst, sink, source, *, kernel=None, col=None, row=None, shift: 
         total = _sum_sig(rowsums, [1] * n)
         insts.append(shift_add([(s, 1) for s in rowsums], total))
 
-    scaled = Signal(intbv(0, min=-(1 << (bits - 1)), max=1 << (bits - 1))) if signed else Signal(intbv(0)[bits:])
+    scaled = fx_signal(fmt)
 
     @always_comb
     def scale():

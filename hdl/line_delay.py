@@ -21,7 +21,9 @@ def line_delay(clk, rst, sink, source, *, width: int = 352, height: int = 288):
         clk: clock, rising edge.
         rst: synchronous reset, active high; clears the control registers, not the memory.
         sink: :class:`~eyestereo.hdl.stream.ImageStream`, 1..36 data bits.
-        source: ImageStream of the same data width; same frames, one clock later.
+        source: ImageStream of the same data width; same frames, one clock later. With stereo
+            streams (``stereo=True``) ``cam`` is forwarded with the beat; the memory does not
+            separate the cameras (interleave whole frames, not lines).
 
     Parameters:
         width: pixels per line (1..4096), the memory depth.
@@ -38,6 +40,9 @@ def line_delay(clk, rst, sink, source, *, width: int = 352, height: int = 288):
         raise ValueError(f"line_delay data width is {dw} bits, at most {MAX_DATA_WIDTH} fit one block RAM word")
     if len(source.data) != dw:
         raise ValueError(f"line_delay source data width {len(source.data)} differs from sink's {dw}")
+
+    if getattr(sink, "stereo", False) != getattr(source, "stereo", False):
+        raise ValueError("line_delay sink and source must both be stereo streams (with cam) or both mono")
 
     mem = [Signal(intbv(0)[dw:]) for _ in range(width)]
     col = Signal(intbv(0, min=0, max=width))
@@ -65,4 +70,11 @@ def line_delay(clk, rst, sink, source, *, width: int = 352, height: int = 288):
     def decode():
         pixel.next = sink.valid and (sink.eol or not sink.eof)
 
-    return ram, control, decode
+    insts = [ram, control, decode]
+    if sink.stereo:
+        @always_seq(clk.posedge, reset=rst)
+        def camera():
+            source.cam.next = sink.cam
+
+        insts.append(camera)
+    return insts

@@ -3,7 +3,10 @@
 from myhdl import Signal, always, block, concat, intbv
 
 from eyestereo.hdl.convolve import en_reg
+from eyestereo.hdl.fixed import fx_signal
 from eyestereo.hdl.window import _sig, column_taps, delay, shift_add, window_control
+from eyestereo.tools.fixed import shift_between
+from eyestereo.tools.sobel import GRAD, OUT
 from eyestereo.tools.stream import check_geometry
 
 LATENCY = 5
@@ -60,23 +63,25 @@ def sobel(clk, rst, sink, source, *, width: int = 352, height: int = 288):
             insts.append(en_reg(clk, col_valid, src, reg))
             src = reg
 
-    gx = _sig(-1020, 1020)
-    gy = _sig(-1020, 1020)
+    gx = fx_signal(GRAD)
+    gy = fx_signal(GRAD)
     insts += [shift_add([(s[0], 1), (s[2], -1)], gx),
               shift_add([(d[0], 1), (d[1], 2), (d[2], 1)], gy)]
 
-    # floor(G / 8) in 9 bits: an arithmetic shift, then the low 9 bits of the two's complement word.
-    qx = Signal(intbv(0, min=-256, max=256))
-    qy = Signal(intbv(0, min=-256, max=256))
+    # Floor to sfix[9,-3]: an arithmetic right shift drops the fraction bits toward minus infinity.
+    qx = fx_signal(OUT)
+    qy = fx_signal(OUT)
+    sh = shift_between(GRAD.fl, OUT.fl)
+    nb = OUT.wl
 
     @always(gx, gy)
     def quantize():
-        qx.next = gx >> 3
-        qy.next = gy >> 3
+        qx.next = gx >> sh
+        qy.next = gy >> sh
 
     @always(clk.posedge)
     def outreg():
-        source.data.next = concat(qy[9:], qx[9:])
+        source.data.next = concat(qy[nb:], qx[nb:])
 
     insts += [quantize, outreg,
               window_control(clk, rst, sink, source, width=width, height=height, radius=1, latency=LATENCY)]

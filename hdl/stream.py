@@ -50,7 +50,7 @@ class ImageStream:
     """
 
     def __init__(self, data_width: int = 8, *, stereo: bool = False):
-        if not isinstance(data_width, int) or data_width < 1:
+        if isinstance(data_width, bool) or not isinstance(data_width, int) or data_width < 1:
             raise ValueError(f"ImageStream data_width must be an int >= 1, got {data_width!r}")
         self.data_width = data_width
         self.stereo = stereo

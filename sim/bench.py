@@ -129,6 +129,11 @@ async def run_scenario(tb: StreamTB, frames: list[np.ndarray], *, token_after: i
     assert not tb.source.queue, "source still holds beats"
     report = dict(frames=len(frames), pixels_compared=compared, beats_out=sink.beats,
                   cycles=tb.sink.cycle, sent=len(tb.source.sent_cycles))
+    if tb.cfg.get("timing"):
+        report["sent_cycles"] = list(tb.source.sent_cycles)
+        report["received_cycles"] = list(tb.sink.received_cycles)
+    if tb.cfg.get("dump"):
+        np.save(tb.cfg["dump"], np.stack(sink.frames))
     return report
 
 

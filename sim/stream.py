@@ -80,8 +80,9 @@ class StreamSource:
 class StreamSink:
     """Monitors ``<prefix>_*`` and rebuilds frames; any protocol fault is recorded and re-raised.
 
-    ``received_cycles`` holds the cycle number of every beat, counted like the source's (the beat a
-    source drives after its n-th rising edge is sampled by the DUT at edge n + 1).
+    ``received_cycles`` holds the cycle number of every beat, counted like the source's: a beat the
+    source drives in cycle n (after rising edge n) is sampled by the DUT at edge n + 1; an output
+    registered at that edge is seen in cycle n + 1, a latency of 1 clock.
     """
 
     def __init__(self, dut, prefix: str, clk, width: int, height: int):
@@ -126,7 +127,7 @@ class StreamSink:
             raw = self.data.value
             data = int(raw) if raw.is_resolvable else UNKNOWN
             self.beats += 1
-            self.received_cycles.append(self.cycle - 1)
+            self.received_cycles.append(self.cycle)
             if self.error is None:
                 try:
                     self.asm.push(data, bool(int(self.eol.value)), bool(int(self.eof.value)))

@@ -95,3 +95,34 @@ def test_sobel_full_frames_back_to_back(request):
 def test_sobel_full_frame_gaps(request):
     _run("sobel", "tb_sobel", dict(width=352, height=288),
          dict(frames=["file:chessboard_left01.jpg"], duty=0.5, seed=7), request)
+
+
+# --- documented latency and one pixel per clock --------------------------------------------------
+@pytest.mark.parametrize("block,bench,params,radius,latency", [
+    ("line_delay", "tb_line_delay", dict(width=20, height=6, data_width=8), 0, 1),
+    ("convolve", "tb_convolve", dict(width=20, height=8, **KERNELS["sep3"]), 1, 5),
+    ("convolve", "tb_convolve", dict(width=20, height=8, **KERNELS["full5"]), 2, 7),
+    ("sobel", "tb_sobel", dict(width=20, height=8), 1, 5),
+], ids=["line_delay", "convolve3", "convolve5", "sobel"])
+def test_latency_and_throughput(request, block, bench, params, radius, latency):
+    """Latency equals the docstring's, and back-to-back frames come out at one pixel per clock."""
+    import numpy as np
+
+    from eyestereo.hdl.catalog import get
+
+    doc = get(block).func.__doc__
+    assert f"Latency: {latency} clock" in doc or "Latency: N + 2 clocks" in doc
+    rep = _run(block, bench, params, dict(frames=["random:1", "random:2", "random:3"], duty=1.0, timing=True),
+               request)
+    w, h = params["width"], params["height"]
+    n = w * h
+    sent, recv = np.array(rep["sent_cycles"]), np.array(rep["received_cycles"])
+    assert len(sent) == len(recv) == 3 * n
+    lead = radius * w + radius
+    for f in range(3):
+        p = np.arange(n - lead)
+        lat = recv[f * n + p] - sent[f * n + p + lead]
+        assert lat.min() == lat.max() == latency, (lat.min(), lat.max())
+    # Frames 2 and 3 each take exactly n clocks at the output: one pixel per clock, no stall.
+    assert recv[2 * n - 1] - recv[n - 1] == n
+    assert recv[3 * n - 1] - recv[2 * n - 1] == n

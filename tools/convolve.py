@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from eyestereo.tools.fixed import Fmt, fit_format
 from eyestereo.tools.window import correlate_int, interior_mask
 
 
@@ -14,24 +15,30 @@ def check_kernel(kernel=None, col=None, row=None) -> tuple[np.ndarray, bool]:
     if kernel is None:
         if col is None or row is None:
             raise ValueError("a separable kernel needs both col= and row=")
-        col = np.asarray(col)
-        row = np.asarray(row)
+        col = _int_coeffs(col, "col")
+        row = _int_coeffs(row, "row")
         if col.ndim != 1 or row.ndim != 1 or len(col) != len(row):
             raise ValueError(f"col and row must be 1-D of equal length, got {col.shape} and {row.shape}")
         kernel = np.outer(col, row)
         separable = True
     else:
-        kernel = np.asarray(kernel)
+        kernel = _int_coeffs(kernel, "kernel")
         separable = False
     if kernel.ndim != 2 or kernel.shape[0] != kernel.shape[1] or kernel.shape[0] not in (3, 5):
         raise ValueError(f"kernel must be 3x3 or 5x5, got shape {kernel.shape}")
-    if not np.issubdtype(kernel.dtype, np.integer):
-        if not np.all(np.asarray(kernel) == np.round(kernel)):
-            raise ValueError("kernel coefficients must be integers (scale them and use shift=)")
-    kernel = np.asarray(kernel, dtype=np.int64)
     if np.abs(kernel).max() >= 1 << 16:
         raise ValueError("kernel coefficients must be below 2**16 in magnitude")
     return kernel, separable
+
+
+def _int_coeffs(values, name: str) -> np.ndarray:
+    """Coefficients as int64, refusing anything that is not an integer (each factor on its own)."""
+    a = np.asarray(values)
+    if a.dtype == bool or not (np.issubdtype(a.dtype, np.integer) or np.issubdtype(a.dtype, np.floating)):
+        raise ValueError(f"{name} coefficients must be integers, got dtype {a.dtype}")
+    if not np.all(np.isfinite(a)) or not np.all(a == np.round(a)):
+        raise ValueError(f"{name} coefficients must be integers (scale them and use shift=), got {a.tolist()}")
+    return a.astype(np.int64)
 
 
 def sum_range(kernel: np.ndarray, data_width: int) -> tuple[int, int]:
@@ -47,13 +54,15 @@ def output_range(kernel: np.ndarray, data_width: int, shift: int) -> tuple[int, 
     return lo >> shift, hi >> shift
 
 
+def output_format(kernel: np.ndarray, data_width: int, shift: int) -> Fmt:
+    """Smallest fixed-point format of the output codes (fraction length 0: integer codes)."""
+    return fit_format(*output_range(kernel, data_width, shift))
+
+
 def output_width(kernel: np.ndarray, data_width: int, shift: int) -> tuple[int, bool]:
     """(bits, signed) of the output word."""
-    lo, hi = output_range(kernel, data_width, shift)
-    if lo < 0:
-        bits = max((-lo - 1).bit_length(), hi.bit_length()) + 1
-        return bits, True
-    return max(hi.bit_length(), 1), False
+    f = output_format(kernel, data_width, shift)
+    return f.wl, f.signed
 
 
 def convolve(frame: np.ndarray, kernel: np.ndarray, shift: int = 0) -> tuple[np.ndarray, np.ndarray]:

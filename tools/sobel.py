@@ -2,13 +2,18 @@
 
 import numpy as np
 
+from eyestereo.tools.fixed import requantize, sfix
 from eyestereo.tools.window import correlate_int, interior_mask
 
 #: Ix kernel (right minus left, as OpenCV's Sobel with dx=1); Iy is its transpose (down minus up).
 KX = np.array([[-1, 0, 1], [-2, 0, 2], [-1, 0, 1]], dtype=np.int64)
 KY = KX.T.copy()
-OUT_BITS = 9  # per component: sfix[9,-3]
-OUT_FL = -3
+#: Full-precision gradient: |G| <= 4 * 255 = 1020 needs sfix[11,0].
+GRAD = sfix(11, 0)
+#: Output format of each component (thesis 6.2.1): the gradient floored to a multiple of 8.
+OUT = sfix(9, -3)
+OUT_BITS = OUT.wl
+OUT_FL = OUT.fl
 
 
 def sobel(frame: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -16,8 +21,8 @@ def sobel(frame: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     frame = np.asarray(frame, dtype=np.int64)
     if frame.ndim != 2:
         raise ValueError(f"sobel wants a 2-D grey image, got shape {frame.shape}")
-    ix = correlate_int(frame, KX) >> 3
-    iy = correlate_int(frame, KY) >> 3
+    ix = requantize(correlate_int(frame, KX), GRAD, OUT)
+    iy = requantize(correlate_int(frame, KY), GRAD, OUT)
     return ix, iy, interior_mask(*frame.shape, 1)
 
 
