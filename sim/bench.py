@@ -144,3 +144,16 @@ def frames_from_config(cfg: dict, width: int, height: int, bits: int = 8) -> lis
 def write_report(cfg: dict, report: dict) -> None:
     if cfg.get("report"):
         Path(cfg["report"]).write_text(json.dumps(report, indent=2) + "\n")
+
+
+async def run_configured(dut, tb_class: type[StreamTB]) -> dict:
+    """The body of a block bench: frames, duty, token and parameters from the runner's config."""
+    cfg = load_config()
+    p = cfg["params"]
+    w, h, bits = p.get("width", 352), p.get("height", 288), p.get("data_width", 8)
+    tb = tb_class(dut, cfg, out_width=w, out_height=h)
+    frames = frames_from_config(cfg, w, h, bits)
+    token_frame = make_frame("random:99", w, h, bits)
+    report = await run_scenario(tb, frames, token_after=cfg.get("token_after"), token_frame=token_frame)
+    write_report(cfg, report)
+    return report
