@@ -10,12 +10,19 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
-from myhdl import ResetSignal, Signal
+from myhdl import ResetSignal, Signal, intbv
 
 from eyestereo.hdl.convolve import convolve
+from eyestereo.hdl.cornerness import cornerness
+from eyestereo.hdl.harris_mono import harris_mono
+from eyestereo.hdl.harris_window import harris_window
+from eyestereo.hdl.nms import nms
+from eyestereo.hdl.prethreshold import prethreshold
 from eyestereo.hdl.line_delay import line_delay
 from eyestereo.hdl.sobel import sobel
 from eyestereo.hdl.stream import ImageStream
+from eyestereo.tools import cornerness as corner_model
+from eyestereo.tools import harris_window as window_model
 from eyestereo.tools.convolve import check_kernel, output_width
 
 
@@ -28,6 +35,8 @@ class BlockSpec:
     sink_width: Callable[[dict], int]
     source_width: Callable[[dict], int]
     hw_params: tuple[str, ...] = field(default=())  # parameters passed to the block function
+    #: control ports after ``source``, in order: name -> function(params) -> fresh Signal
+    control: tuple[tuple[str, Callable[[dict], object]], ...] = field(default=())
 
     def params(self, **overrides) -> dict:
         unknown = set(overrides) - set(self.defaults)
@@ -45,11 +54,25 @@ class BlockSpec:
         sink = ImageStream(self.sink_width(p))
         source = ImageStream(self.source_width(p))
         kw = {k: v for k, v in p.items() if k in self.hw_params}
-        inst = self.func(clk, rst, sink, source, **kw)
-        return inst, dict(clk=clk, rst=rst, sink=sink, source=source), p
+        ctrl = {name: make(p) for name, make in self.control}
+        inst = self.func(clk, rst, sink, source, *ctrl.values(), **kw)
+        return inst, dict(clk=clk, rst=rst, sink=sink, source=source, **ctrl), p
 
     def entity(self, **overrides) -> str:
         return self.name
+
+
+def _k_port(p):
+    return Signal(intbv(0)[corner_model.K.wl:])
+
+
+def _thr_ports():
+    def addr(p):
+        n = p["blocks"][0] * p["blocks"][1]
+        return Signal(intbv(0)[max(1, (n - 1).bit_length()):])
+
+    return (("thr_we", lambda p: Signal(bool(0))), ("thr_addr", addr),
+            ("thr_data", lambda p: Signal(intbv(0)[corner_model.OUT.wl:])))
 
 
 def _conv_width(p):
@@ -72,6 +95,29 @@ BLOCKS: dict[str, BlockSpec] = {
         "sobel", "separable 3x3 Sobel, Ix and Iy as sfix[9,-3]", sobel,
         dict(width=352, height=288),
         sink_width=lambda p: 8, source_width=lambda p: 18, hw_params=("width", "height")),
+    "harris_window": BlockSpec(
+        "harris_window", "Ix^2, Iy^2, IxIy packed in 36 bits, summed over a 5x5 [1 2 4 2 1]^2 window",
+        harris_window, dict(width=352, height=288),
+        sink_width=lambda p: 18, source_width=lambda p: window_model.OUT_BITS, hw_params=("width", "height")),
+    "cornerness": BlockSpec(
+        "cornerness", "det(G) - k trace(G)^2, 6-stage pipeline, 4 multipliers, 20-bit output", cornerness,
+        dict(width=352, height=288),
+        sink_width=lambda p: window_model.OUT_BITS, source_width=lambda p: corner_model.OUT.wl,
+        hw_params=("width", "height"), control=(("k", _k_port),)),
+    "prethreshold": BlockSpec(
+        "prethreshold", "cornerness > its block's run-time threshold, else 0 (BX x BY blocks)", prethreshold,
+        dict(width=352, height=288, blocks=(4, 4)),
+        sink_width=lambda p: corner_model.OUT.wl, source_width=lambda p: corner_model.OUT.wl,
+        hw_params=("width", "height", "blocks"), control=_thr_ports()),
+    "nms": BlockSpec(
+        "nms", "separable non-maximum suppression 1x1/3x3/5x5 with a raster tie rule, 1-bit flags", nms,
+        dict(width=352, height=288, size=3),
+        sink_width=lambda p: corner_model.OUT.wl, source_width=lambda p: 1, hw_params=("width", "height", "size")),
+    "harris_mono": BlockSpec(
+        "harris_mono", "Harris corners: Sobel -> window -> cornerness -> pre-threshold -> NMS", harris_mono,
+        dict(width=352, height=288, blocks=(4, 4), nms=3),
+        sink_width=lambda p: 8, source_width=lambda p: 1, hw_params=("width", "height", "blocks", "nms"),
+        control=(("k", _k_port),) + _thr_ports()),
 }
 
 

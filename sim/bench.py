@@ -27,7 +27,18 @@ def load_config() -> dict:
 
 
 def make_frame(spec: str, width: int, height: int, bits: int = 8) -> np.ndarray:
-    """A stimulus frame: ``random:SEED``, ``ramp``, or ``file:NAME`` (from tests/data, cropped)."""
+    """A stimulus frame of stream words.
+
+    Images (8-bit): ``random:SEED``, ``ramp``, ``file:NAME`` (from tests/data, centre crop), ``pattern:SEED``
+    (the corner test pattern). Random words of other widths: ``random:SEED`` uses ``bits``.
+    Inputs for later stages, built with the bit-true models from an image spec after the colon:
+    ``sobel:IMG`` (Sobel words), ``window:IMG`` (harris_window words), ``corner:K:IMG`` (cornerness
+    words for k code K). Random inputs over a stage's full range: ``grad:SEED:LIM`` (Sobel words with
+    codes in [-LIM, LIM)), ``rwindow:SEED`` (window words), ``rcorner:SEED:LO:HI`` (cornerness codes in
+    [LO, HI]).
+    """
+    from eyestereo.tools import cornerness, harris_window, sobel
+
     kind, _, arg = spec.partition(":")
     if kind == "random":
         return np.random.default_rng(int(arg)).integers(0, 1 << bits, (height, width), dtype=np.int64)
@@ -42,8 +53,31 @@ def make_frame(spec: str, width: int, height: int, bits: int = 8) -> np.ndarray:
             raise ValueError(f"{arg} is {img.shape[1]}x{img.shape[0]}, smaller than {width}x{height}")
         y0 = (img.shape[0] - height) // 2
         x0 = (img.shape[1] - width) // 2
-        return img[y0:y0 + height, x0:x0 + width].astype(np.int64) >> (8 - bits) if bits <= 8 else \
-            img[y0:y0 + height, x0:x0 + width].astype(np.int64)
+        return img[y0:y0 + height, x0:x0 + width].astype(np.int64)
+    if kind == "pattern":
+        from eyestereo.tools.testpattern import corner_pattern
+
+        return corner_pattern(width, height, seed=int(arg)).image.astype(np.int64)
+    if kind == "sobel":
+        return sobel.pack(*sobel.sobel(make_frame(arg, width, height))[:2])
+    if kind == "window":
+        return harris_window.harris_window(make_frame(f"sobel:{arg}", width, height))[0]
+    if kind == "corner":
+        k, _, img = arg.partition(":")
+        return cornerness.to_word(cornerness.cornerness(make_frame(f"window:{img}", width, height), int(k)))
+    rng_seed, _, rest = arg.partition(":")
+    rng = np.random.default_rng(int(rng_seed) if rng_seed else 0)
+    if kind == "grad":
+        lim = int(rest or 128)
+        ix, iy = (rng.integers(-lim, lim, (height, width)) for _ in range(2))
+        return sobel.pack(ix, iy)
+    if kind == "rwindow":
+        sq, xy = harris_window.SUM_SQ, harris_window.SUM_XY
+        sxx, syy = (rng.integers(sq.lo, sq.hi + 1, (height, width)) for _ in range(2))
+        return harris_window.pack(sxx, syy, rng.integers(xy.lo, xy.hi + 1, (height, width)))
+    if kind == "rcorner":
+        lo, _, hi = rest.partition(":")
+        return cornerness.to_word(rng.integers(int(lo), int(hi) + 1, (height, width)))
     raise ValueError(f"unknown stimulus {spec!r}")
 
 
@@ -51,6 +85,7 @@ class StreamTB:
     """Clock, reset, source (with idle generator) and sink around a stream block."""
 
     period_ns = 10
+    token_spec = "random:99"  # stimulus of the partial frame cut by the reset token
 
     def __init__(self, dut, cfg: dict, *, out_width: int, out_height: int):
         self.dut = dut
@@ -66,6 +101,13 @@ class StreamTB:
         self.dut.rst.value = 0
         self.sink.active = True
         await RisingEdge(self.clk)
+
+    def make_input(self, spec: str, width: int, height: int) -> np.ndarray:
+        """One input frame for a stimulus spec (see :func:`make_frame`)."""
+        return make_frame(spec, width, height, self.cfg["params"].get("data_width", 8))
+
+    async def configure(self) -> None:
+        """Drive the block's control ports after reset (blocks with such ports override this)."""
 
     def expected(self, frame: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(expected output words, mask of the pixels whose data is specified) for one input frame."""
@@ -95,6 +137,7 @@ async def run_scenario(tb: StreamTB, frames: list[np.ndarray], *, token_after: i
     token, nothing left pending, nothing extra.
     """
     await tb.reset()
+    await tb.configure()
     tokens = 0
     if token_after is not None:
         tb.source.send_beats(frame_to_beats(token_frame)[:token_after])
@@ -137,10 +180,6 @@ async def run_scenario(tb: StreamTB, frames: list[np.ndarray], *, token_after: i
     return report
 
 
-def frames_from_config(cfg: dict, width: int, height: int, bits: int = 8) -> list[np.ndarray]:
-    return [make_frame(s, width, height, bits) for s in cfg.get("frames", ["random:1", "random:2"])]
-
-
 def write_report(cfg: dict, report: dict) -> None:
     if cfg.get("report"):
         Path(cfg["report"]).write_text(json.dumps(report, indent=2) + "\n")
@@ -150,10 +189,10 @@ async def run_configured(dut, tb_class: type[StreamTB]) -> dict:
     """The body of a block bench: frames, duty, token and parameters from the runner's config."""
     cfg = load_config()
     p = cfg["params"]
-    w, h, bits = p.get("width", 352), p.get("height", 288), p.get("data_width", 8)
+    w, h = p.get("width", 352), p.get("height", 288)
     tb = tb_class(dut, cfg, out_width=w, out_height=h)
-    frames = frames_from_config(cfg, w, h, bits)
-    token_frame = make_frame("random:99", w, h, bits)
+    frames = [tb.make_input(spec, w, h) for spec in cfg.get("frames", ["random:1", "random:2"])]
+    token_frame = tb.make_input(cfg.get("token_frame", tb.token_spec), w, h)
     report = await run_scenario(tb, frames, token_after=cfg.get("token_after"), token_frame=token_frame)
     write_report(cfg, report)
     return report

@@ -1,0 +1,112 @@
+"""Harris cornerness c = det(G) - k trace(G)^2, fully pipelined, multiplier inputs <= 18 bits (thesis 6.2.3)."""
+
+from myhdl import Signal, always, always_comb, block, intbv
+
+from eyestereo.hdl.fixed import fx_signal
+from eyestereo.hdl.window import delay_rst
+from eyestereo.tools import cornerness as model
+from eyestereo.tools import harris_window as window_model
+from eyestereo.tools.stream import check_geometry
+
+LATENCY = model.LATENCY
+
+
+@block
+def cornerness(clk, rst, sink, source, k, *, width: int = 352, height: int = 288):
+    """Cornerness of every pixel from the window sums; a point operation, 6 pipeline stages.
+
+    Stages (formats in :mod:`eyestereo.tools.cornerness`): the sums are cut to 17 bits (a, b, c, and
+    the half trace t), so each of the 4 multipliers (a*b, c*c, k*t, (k*t >> 8)*t) takes operands that
+    fit a MULT18X18's signed 18-bit inputs; det - 4 k t^2 is formed in 37 bits and shifted right by 13
+    into the 20-bit output with saturation, which never triggers on the positive side for windows of
+    Sobel gradients, so corners are never wrapped or clamped and keep their order.
+
+    Ports:
+        clk, rst: clock and synchronous active-high reset (control only).
+        sink: ImageStream, 57 bits from ``harris_window`` (Sxy | Syy | Sxx).
+        source: ImageStream, 20 bits: the cornerness, two's complement (units:
+            :func:`eyestereo.tools.harris_mono.harris_float` / 2**21).
+        k: input, 8 bits, ufix[8,8]: k = code / 256 (:func:`eyestereo.tools.harris_mono.k_code`);
+            sampled every clock, change it between frames.
+
+    Parameters:
+        width, height: frame size (only checked: a point operation keeps no position).
+
+    Latency: 6 clocks.
+
+    Resources: 4 MULT18X18, adders and pipeline registers, no block RAM.
+    """
+    check_geometry(width, height)
+    if len(sink.data) != window_model.OUT_BITS:
+        raise ValueError(f"cornerness takes {window_model.OUT_BITS}-bit window words, sink has {len(sink.data)}")
+    if len(source.data) != model.OUT.wl:
+        raise ValueError(f"cornerness source carries {model.OUT.wl} bits, has {len(source.data)}")
+    if len(k) != model.K.wl:
+        raise ValueError(f"k port must be {model.K.wl} bits (ufix[8,8]), got {len(k)}")
+
+    S = model.STAGES
+    sxx, syy = fx_signal(window_model.SUM_SQ), fx_signal(window_model.SUM_SQ)
+    sxy = fx_signal(window_model.SUM_XY)
+    a, b, c, t = fx_signal(S["a"]), fx_signal(S["b"]), fx_signal(S["c"]), fx_signal(S["t"])
+    ab, cc, kt, t2 = fx_signal(S["ab"]), fx_signal(S["cc"]), fx_signal(S["kt"]), fx_signal(S["t"])
+    det, kt8, t3 = fx_signal(S["det"]), fx_signal(S["kt8"]), fx_signal(S["t"])
+    ktt, det4 = fx_signal(S["ktt"]), fx_signal(S["det"])
+    cr = fx_signal(S["cr"])
+    crs = Signal(intbv(0, min=S["cr"].lo >> model.OUT_SHIFT, max=(S["cr"].hi >> model.OUT_SHIFT) + 1))
+    cout = fx_signal(model.OUT)
+    shift, lo, hi, nb = model.OUT_SHIFT, model.OUT.lo, model.OUT.hi, model.OUT.wl
+
+    trace = Signal(intbv(0, min=0, max=2 * window_model.SUM_SQ.hi + 1))
+
+    @always_comb
+    def fields():
+        sxx.next = sink.data[19:0]
+        syy.next = sink.data[38:19]
+        sxy.next = sink.data[57:38]
+
+    # A sum of its own: VHDL adds in the operands' width (19 bits), which would wrap.
+    @always_comb
+    def add():
+        trace.next = sxx + syy
+
+    @always(clk.posedge)
+    def pipeline():
+        # 1: cut to 17 bits
+        a.next = sxx >> 2
+        b.next = syy >> 2
+        c.next = sxy >> 2
+        t.next = trace >> 3
+        # 2: the three multipliers of the first rank
+        ab.next = a * b
+        cc.next = c * c
+        kt.next = k * t
+        t2.next = t
+        # 3
+        det.next = ab - cc
+        kt8.next = kt >> 8
+        t3.next = t2
+        # 4: the fourth multiplier
+        ktt.next = kt8 * t3
+        det4.next = det
+        # 5: trace^2 = (2t)^2 = 4 t^2
+        cr.next = det4 - (ktt << 2)
+        # 6
+        source.data.next = cout[nb:]
+
+    @always_comb
+    def clamp():
+        crs.next = cr >> shift
+
+    @always_comb
+    def saturate():
+        if crs > hi:
+            cout.next = hi
+        elif crs < lo:
+            cout.next = lo
+        else:
+            cout.next = crs
+
+    insts = [fields, add, pipeline, clamp, saturate]
+    for s, d in ((sink.valid, source.valid), (sink.eol, source.eol), (sink.eof, source.eof)):
+        insts.append(delay_rst(clk, rst, s, d, clocks=LATENCY))
+    return insts

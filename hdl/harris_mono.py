@@ -1,0 +1,74 @@
+"""Mono Harris corner detector: Sobel -> window -> cornerness -> pre-threshold -> NMS, one pixel per clock."""
+
+from myhdl import block
+
+from eyestereo.hdl.cornerness import LATENCY as CORNER_LATENCY
+from eyestereo.hdl.cornerness import cornerness
+from eyestereo.hdl.harris_window import LATENCY as WINDOW_LATENCY
+from eyestereo.hdl.harris_window import harris_window
+from eyestereo.hdl.nms import nms as nms_block
+from eyestereo.hdl.prethreshold import prethreshold
+from eyestereo.hdl.sobel import LATENCY as SOBEL_LATENCY
+from eyestereo.hdl.sobel import sobel
+from eyestereo.hdl.stream import ImageStream
+from eyestereo.tools import cornerness as corner_model
+from eyestereo.tools import harris_window as window_model
+from eyestereo.tools.harris_mono import check_params, k_code, radius, threshold_code  # noqa: F401 (re-export)
+from eyestereo.tools.stream import check_geometry
+
+
+def latency(nms: int) -> tuple[int, int]:
+    """(clocks, window lead r): flag (x, y) comes that many clocks after input pixel (x + r, y + r)."""
+    nms_lat = 1 if nms == 1 else nms + 2
+    return SOBEL_LATENCY + WINDOW_LATENCY + CORNER_LATENCY + 1 + nms_lat, radius(nms)
+
+
+@block
+def harris_mono(clk, rst, sink, source, k, thr_we, thr_addr, thr_data, *, width: int = 352,
+                height: int = 288, blocks: tuple[int, int] = (4, 4), nms: int = 3):
+    """Harris corners of an 8-bit grey stream: ``source`` flag (x, y) = 1 for a corner at input pixel (x, y).
+
+    The chain of :func:`~eyestereo.hdl.sobel.sobel`, :func:`~eyestereo.hdl.harris_window.harris_window`,
+    :func:`~eyestereo.hdl.cornerness.cornerness`, :func:`~eyestereo.hdl.prethreshold.prethreshold` and
+    :func:`~eyestereo.hdl.nms.nms`, each keeping the frame geometry, so the output frame has the input's
+    size and flags. Flags within r = 3 + nms // 2 pixels of the border are unspecified.
+
+    Ports:
+        clk, rst: clock and synchronous active-high reset.
+        sink: ImageStream, 8-bit grey pixels.
+        source: ImageStream, 1 bit: the feature flag.
+        k: input, 8 bits, ufix[8,8] (k = code / 256); ``k_code(0.04)`` gives the code.
+        thr_we, thr_addr, thr_data: the pre-threshold's register port (block index by*BX + bx, 20-bit
+            threshold code; ``threshold_code(c)`` converts a threshold in harris_float units). All
+            thresholds are 0 after ``rst``.
+
+    Parameters:
+        width, height: frame size, each 5..4096, default 352x288.
+        blocks: (BX, BY) threshold blocks, default (4, 4): 88x72-pixel blocks at 352x288.
+        nms: 1, 3 or 5: non-maximum suppression window.
+
+    Latency: :func:`latency` -- nms 3: 3 lines + 3 pixels + 25 clocks; nms 5: 4 lines + 4 pixels +
+    27 clocks; nms 1: 3 lines + 3 pixels + 21 clocks.
+
+    Resources: 6 (nms 1) to 10 (nms 5) RAMB16, 7 multipliers (3 window, 4 cornerness); see docs/benchmarks.md.
+    """
+    check_geometry(width, height, min_size=5)
+    if (not isinstance(blocks, (tuple, list)) or len(blocks) != 2):
+        raise ValueError(f"blocks must be a pair of ints (BX, BY), got {blocks!r}")
+    check_params(width, height, tuple(blocks), nms)
+    if len(sink.data) != 8:
+        raise ValueError(f"harris_mono takes 8-bit pixels, sink has {len(sink.data)} bits")
+    if len(source.data) != 1:
+        raise ValueError(f"harris_mono source carries a 1-bit flag, has {len(source.data)} bits")
+    s_sobel = ImageStream(18)
+    s_window = ImageStream(window_model.OUT_BITS)
+    s_corner = ImageStream(corner_model.OUT.wl)
+    s_pre = ImageStream(corner_model.OUT.wl)
+    return [
+        sobel(clk, rst, sink, s_sobel, width=width, height=height),
+        harris_window(clk, rst, s_sobel, s_window, width=width, height=height),
+        cornerness(clk, rst, s_window, s_corner, k, width=width, height=height),
+        prethreshold(clk, rst, s_corner, s_pre, thr_we, thr_addr, thr_data, width=width, height=height,
+                     blocks=tuple(blocks)),
+        nms_block(clk, rst, s_pre, source, width=width, height=height, size=nms),
+    ]

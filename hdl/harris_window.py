@@ -1,0 +1,139 @@
+"""Harris window function: Ix^2, Iy^2, IxIy summed over a separable 5x5 [1 2 4 2 1]^2 window (thesis 6.2.2)."""
+
+from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv
+
+from eyestereo.hdl.convolve import en_reg
+from eyestereo.hdl.fixed import fx_signal
+from eyestereo.hdl.stream import ImageStream
+from eyestereo.hdl.window import _sig, column_taps, delay, shift_add, window_control
+from eyestereo.tools import harris_window as model
+from eyestereo.tools.fixed import sfix
+from eyestereo.tools.stream import check_geometry
+
+N = 5
+LATENCY = 8  # 1 product stage + the window's N + 2
+
+
+@block
+def harris_window(clk, rst, sink, source, *, width: int = 352, height: int = 288):
+    """Structure-tensor sums: ``source`` pixel (x, y) = (Sxy, Syy, Sxx) over the 5x5 window centred on (x, y).
+
+    Each incoming (Ix, Iy) pair is squared and multiplied first (3 multipliers), each product floored
+    by 8 and saturated to 12 bits (ufix[12,-9], ufix[12,-9], sfix[12,-9]; Sobel codes never saturate),
+    and the three are packed into one 36-bit word, so a single set of four line delays (one RAMB16
+    each) carries them. The separable weighted sum [1 2 4 2 1] x [1 2 4 2 1] runs by shifts and adds
+    on the unpacked taps; its "/128" is a move of the binary point, so no bit is dropped: Sxx, Syy are
+    ufix[19,-2], Sxy sfix[19,-2]. Pixels within 2 of the border carry unspecified data.
+
+    Ports:
+        clk, rst: clock and synchronous active-high reset (control only).
+        sink: ImageStream, 18 bits: Iy in bits 17..9, Ix in 8..0 (sfix[9,-3] codes, as from ``sobel``).
+        source: ImageStream, 57 bits: Sxy in 56..38 (two's complement), Syy in 37..19, Sxx in 18..0.
+
+    Parameters:
+        width, height: frame size, each 5..4096.
+
+    Latency: 8 clocks after input pixel (x + 2, y + 2): 2 lines + 2 pixels + 8 clocks.
+
+    Resources: 3 multipliers (9x9), 4 line delays of 36 bits (4 RAMB16), adders and registers.
+    """
+    check_geometry(width, height, min_size=N)
+    if len(sink.data) != 18:
+        raise ValueError(f"harris_window takes 18-bit Sobel words (Iy, Ix), sink has {len(sink.data)} bits")
+    if len(source.data) != model.OUT_BITS:
+        raise ValueError(f"harris_window source carries {model.OUT_BITS} bits, has {len(source.data)}")
+
+    ix = fx_signal(sfix(9))
+    iy = fx_signal(sfix(9))
+    fxx, fyy, fxy = _sig(0, 65536), _sig(0, 65536), _sig(-65280, 65536)
+    qxx, qyy = fx_signal(model.PROD_SQ), fx_signal(model.PROD_SQ)
+    qxy = fx_signal(model.PROD_XY)
+    sq_top = model.PROD_SQ.hi
+    xy_lo, xy_hi = model.PROD_XY.lo, model.PROD_XY.hi
+
+    @always_comb
+    def fields():
+        ix.next = sink.data[9:]
+        iy.next = sink.data[18:9]
+
+    @always_comb
+    def multiply():
+        fxx.next = ix * ix
+        fyy.next = iy * iy
+        fxy.next = ix * iy
+
+    # Floor by 8, then clamp: only inputs outside the Sobel's range can reach the clamps.
+    @always_comb
+    def saturate():
+        if (fxx >> 3) > sq_top:
+            qxx.next = sq_top
+        else:
+            qxx.next = fxx >> 3
+        if (fyy >> 3) > sq_top:
+            qyy.next = sq_top
+        else:
+            qyy.next = fyy >> 3
+        if (fxy >> 3) > xy_hi:
+            qxy.next = xy_hi
+        elif (fxy >> 3) < xy_lo:
+            qxy.next = xy_lo
+        else:
+            qxy.next = fxy >> 3
+
+    prod = ImageStream(model.PACK_BITS)
+
+    @always(clk.posedge)
+    def pack():
+        prod.data.next = concat(qxy[12:], qyy[12:], qxx[12:])
+
+    @always_seq(clk.posedge, reset=rst)
+    def flags():
+        prod.valid.next = sink.valid
+        prod.eol.next = sink.eol
+        prod.eof.next = sink.eof
+
+    taps = [Signal(intbv(0)[model.PACK_BITS:]) for _ in range(N)]
+    tap_valid = Signal(bool(0))
+    insts = [fields, multiply, saturate, pack, flags,
+             column_taps(clk, rst, prod, taps, tap_valid, width=width, height=height)]
+
+    weights = [int(w) for w in model.TAPS]
+    col_valid = Signal(bool(0))
+    insts.append(delay(clk, tap_valid, col_valid, clocks=1))
+    sums = []
+    for lo_bit, fmt in ((0, model.PROD_SQ), (12, model.PROD_SQ), (24, model.PROD_XY)):
+        fields_i = [fx_signal(fmt) for _ in range(N)]
+        for tap, f in zip(taps, fields_i):
+            insts.append(field(tap, f, lo_bit))
+        vlo = fmt.lo * sum(weights)
+        vhi = fmt.hi * sum(weights)
+        vsum, vreg = _sig(vlo, vhi), _sig(vlo, vhi)
+        insts += [shift_add(list(zip(fields_i, weights)), vsum), delay(clk, vsum, vreg, clocks=1)]
+        row = [_sig(vlo, vhi) for _ in range(N)]
+        src = vreg
+        for reg in row:
+            insts.append(en_reg(clk, col_valid, src, reg))
+            src = reg
+        total = fx_signal(model.SUM_XY if fmt.signed else model.SUM_SQ)
+        insts.append(shift_add(list(zip(row, weights)), total))
+        sums.append(total)
+    sxx, syy, sxy = sums
+
+    @always(clk.posedge)
+    def outreg():
+        source.data.next = concat(sxy[19:], syy[19:], sxx[19:])
+
+    insts += [outreg, window_control(clk, rst, prod, source, width=width, height=height, radius=N // 2,
+                                     latency=N + 2)]
+    return insts
+
+
+@block
+def field(word, out, lo_bit: int):
+    hi_bit = lo_bit + len(out)
+
+    @always_comb
+    def extract():
+        out.next = word[hi_bit:lo_bit]
+
+    return extract

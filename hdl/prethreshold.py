@@ -1,0 +1,135 @@
+"""Segmented pre-threshold: the image cut into BX x BY blocks, one run-time threshold each (thesis 6.2.4)."""
+
+from myhdl import Signal, always, always_comb, always_seq, block, intbv
+
+from eyestereo.hdl.fixed import fx_signal
+from eyestereo.tools import cornerness as corner_model
+from eyestereo.tools.prethreshold import block_edges
+from eyestereo.tools.stream import check_geometry
+
+
+@block
+def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: int = 352, height: int = 288,
+                 blocks: tuple[int, int] = (4, 4)):
+    """``source`` = cornerness where it is greater than its block's threshold, else 0.
+
+    Block (bx, by) covers columns [bx*W//BX, (bx+1)*W//BX) and rows [by*H//BY, (by+1)*H//BY); its index
+    is by*BX + bx. The thresholds sit in a small distributed RAM (one LUT per bit for up to 16 blocks)
+    plus one "written" flag per block; the flags clear on ``rst``, so every threshold reads 0 after a
+    reset. A write takes effect from the next clock: write between frames for a consistent frame.
+
+    Ports:
+        clk, rst: clock and synchronous active-high reset.
+        sink: ImageStream, 20 bits, cornerness (two's complement), e.g. from ``cornerness``.
+        source: ImageStream, 20 bits, same format.
+        thr_we: input, write enable of the threshold register port.
+        thr_addr: input, block index by*BX + bx (writes to indices >= BX*BY are ignored).
+        thr_data: input, 20 bits, the threshold in the cornerness format (signed).
+
+    Parameters:
+        width, height: frame size, 1..4096.
+        blocks: (BX, BY), each 1..16 and at most the frame size; (1, 1) is a global threshold.
+
+    Latency: 1 clock.
+
+    Resources: BX*BY x 20 bits of LUT-RAM, BX*BY flag registers, position counters, one comparator.
+    """
+    check_geometry(width, height)
+    if (not isinstance(blocks, (tuple, list)) or len(blocks) != 2
+            or not all(isinstance(v, int) and not isinstance(v, bool) for v in blocks)):
+        raise ValueError(f"blocks must be a pair of ints (BX, BY), got {blocks!r}")
+    bxn, byn = blocks
+    if not (1 <= bxn <= min(16, width) and 1 <= byn <= min(16, height)):
+        raise ValueError(f"blocks={tuple(blocks)}: BX and BY must be 1..16 and at most the frame's width/height")
+    nb = corner_model.OUT.wl
+    for name, sig in (("sink", sink.data), ("source", source.data), ("thr_data", thr_data)):
+        if len(sig) != nb:
+            raise ValueError(f"prethreshold {name} must be {nb} bits (the cornerness format), has {len(sig)}")
+    nblk = bxn * byn
+    abits = max(1, (nblk - 1).bit_length())
+    if len(thr_addr) < abits:
+        raise ValueError(f"thr_addr needs {abits} bits for {nblk} blocks, has {len(thr_addr)}")
+
+    # Last column / row of each block, as ROM tables indexed by the block counters.
+    x_last = tuple(int(e) - 1 for e in block_edges(width, bxn)[1:])
+    y_last = tuple(int(e) - 1 for e in block_edges(height, byn)[1:])
+    mem = [Signal(intbv(0)[nb:]) for _ in range(nblk)]
+    written = Signal(intbv(0)[nblk:])
+    x = Signal(intbv(0, min=0, max=width))
+    y = Signal(intbv(0, min=0, max=height))
+    bx = Signal(intbv(0, min=0, max=bxn))
+    by = Signal(intbv(0, min=0, max=byn))
+    base = Signal(intbv(0, min=0, max=nblk))  # by * BX
+    blk = Signal(intbv(0, min=0, max=nblk))
+    stored = Signal(intbv(0)[nb:])
+    thr = fx_signal(corner_model.OUT)
+    value = fx_signal(corner_model.OUT)
+    xl = Signal(intbv(0, min=0, max=width))
+    yl = Signal(intbv(0, min=0, max=height))
+
+    @always(clk.posedge)
+    def ram():
+        if thr_we and thr_addr < nblk:
+            mem[thr_addr].next = thr_data
+
+    @always_seq(clk.posedge, reset=rst)
+    def flags():
+        if thr_we and thr_addr < nblk:
+            written.next[thr_addr] = 1
+
+    @always_comb
+    def lookup():
+        blk.next = base + bx
+        xl.next = x_last[bx]
+        yl.next = y_last[by]
+
+    @always_comb
+    def read():
+        stored.next = mem[blk]
+
+    @always_comb
+    def choose():
+        value.next = sink.data
+        if written[blk]:
+            thr.next = stored
+        else:
+            thr.next = 0
+
+    @always_seq(clk.posedge, reset=rst)
+    def position():
+        if sink.valid:
+            if sink.eof:
+                # end of frame or reset token: back to pixel (0, 0)
+                x.next = 0
+                y.next = 0
+                bx.next = 0
+                by.next = 0
+                base.next = 0
+            elif sink.eol or x == width - 1:
+                x.next = 0
+                bx.next = 0
+                if y == height - 1:
+                    y.next = 0
+                    by.next = 0
+                    base.next = 0
+                else:
+                    y.next = y + 1
+                    if y == yl:
+                        by.next = by + 1
+                        base.next = base + bxn
+            else:
+                x.next = x + 1
+                if x == xl:
+                    bx.next = bx + 1
+
+    @always_seq(clk.posedge, reset=rst)
+    def emit():
+        source.valid.next = sink.valid
+        source.eol.next = sink.eol
+        source.eof.next = sink.eof
+        if value > thr:
+            source.data.next = sink.data
+        else:
+            source.data.next = 0
+
+    return ram, flags, lookup, read, choose, position, emit

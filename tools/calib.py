@@ -1,0 +1,465 @@
+"""Stereo calibration from chessboard image pairs (Rectification Toolbox, step 1).
+
+The thesis calibrated the EyeBot M6 stereo rig with Bouguet's Camera Calibration Toolbox for MATLAB
+(thesis 3.5, Appendix A); here OpenCV does the same job:
+
+1. every image pair is searched for the chessboard's inner corners (``findChessboardCorners``, then
+   ``cornerSubPix`` with a window sized from the corner spacing); a pair whose board is not found in
+   *both* images is skipped and reported, fewer than 3 usable pairs is an error;
+2. each camera is calibrated on its own (``calibrateCamera``, model k1, k2, p1, p2, k3: the thesis's
+   k1, k2, k5 radial and k3, k4 tangential terms in OpenCV's order);
+3. ``stereoCalibrate`` estimates the rotation ``R`` and translation ``T`` between the cameras
+   (``X_right = R @ X_left + T``, ``T`` in the units of ``square``). By default it starts from step 2's
+   intrinsics and **refines all parameters jointly** (``CALIB_USE_INTRINSIC_GUESS``): the stereo
+   constraint then helps the intrinsics too, and the reprojection error is the maximum-likelihood one.
+   ``refine=False`` keeps the per-camera intrinsics fixed (``CALIB_FIX_INTRINSIC``), as the thesis's
+   two-step MATLAB procedure did.
+
+The result is a :class:`StereoCalibration`, stored as an OpenCV FileStorage YAML file with exactly the
+keys ``M1, D1, M2, D2, R, T, image_width, image_height, rms`` (:func:`write_yaml`, :func:`read_yaml`).
+Every file this toolbox writes is written atomically (:func:`atomic_output`): a temporary file in the
+same folder, renamed over the target only when complete.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import glob as _glob
+import os
+import re
+import tempfile
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+
+from eyestereo.tools.progress import Progress
+
+__all__ = [
+    "YAML_KEYS",
+    "StereoCalibration",
+    "atomic_output",
+    "atomic_write_bytes",
+    "board_object_points",
+    "calibrate_stereo",
+    "expand_images",
+    "find_corners",
+    "parse_board",
+    "read_yaml",
+    "write_yaml",
+]
+
+#: The keys of a calibration file, in the order they are written.
+YAML_KEYS = ("M1", "D1", "M2", "D2", "R", "T", "image_width", "image_height", "rms")
+
+#: Distortion vector lengths OpenCV knows: (k1 k2 p1 p2), + k3, + k4 k5 k6 (rational),
+#: + s1..s4 (thin prism), + tau_x tau_y (tilted sensor).
+DIST_LENGTHS = (4, 5, 8, 12, 14)
+
+_SUBPIX_CRITERIA = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 60, 1e-4)
+_CALIB_CRITERIA = (cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 200, 1e-9)
+
+
+# --------------------------------------------------------------------------------------------------
+# Atomic output
+
+
+@contextlib.contextmanager
+def atomic_output(path: str | os.PathLike[str], suffix: str | None = None) -> Iterator[Path]:
+    """Yield a temporary path beside ``path``; on success rename it over ``path``, else delete it.
+
+    The temporary name keeps ``path``'s suffix (or ``suffix``) so that writers which pick the format
+    from the name (OpenCV's FileStorage and imwrite, matplotlib) write the right format.
+    """
+    target = Path(path)
+    folder = target.parent if str(target.parent) else Path(".")
+    if not folder.is_dir():
+        raise ValueError(f"cannot write {target}: folder {folder} does not exist")
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix or target.suffix, dir=folder)
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        yield tmp_path
+        if not tmp_path.exists() or tmp_path.stat().st_size == 0:
+            raise ValueError(f"writing {target} produced no data")
+        os.replace(tmp_path, target)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            tmp_path.unlink()
+
+
+def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
+    """Write ``data`` to ``path`` atomically."""
+    with atomic_output(path) as tmp:
+        tmp.write_bytes(data)
+
+
+# --------------------------------------------------------------------------------------------------
+# The calibration record
+
+
+@dataclass
+class StereoCalibration:
+    """Intrinsics of both cameras and their relative pose.
+
+    ``M1``/``M2``: 3x3 camera matrices; ``D1``/``D2``: distortion vectors in OpenCV's order
+    ``k1 k2 p1 p2 [k3 [k4 k5 k6 [s1 s2 s3 s4 [tx ty]]]]``; ``R`` (3x3), ``T`` (3,): pose of the right
+    camera relative to the left, ``X_right = R @ X_left + T``; ``image_width``/``image_height``: the
+    calibrated image size in pixels; ``rms``: the stereo reprojection error in pixels (0 for a
+    calibration that was not estimated, e.g. the synthetic rig's truth). ``info`` holds what the
+    estimation found out (pairs used and skipped, per-camera RMS); it is not stored in the YAML file.
+    """
+
+    M1: np.ndarray
+    D1: np.ndarray
+    M2: np.ndarray
+    D2: np.ndarray
+    R: np.ndarray
+    T: np.ndarray
+    image_width: int
+    image_height: int
+    rms: float = 0.0
+    info: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self.M1 = _as_matrix(self.M1, (3, 3), "M1")
+        self.M2 = _as_matrix(self.M2, (3, 3), "M2")
+        self.D1 = _as_dist(self.D1, "D1")
+        self.D2 = _as_dist(self.D2, "D2")
+        self.R = _as_rotation(self.R, "R")
+        self.T = _as_vector3(self.T, "T")
+        for name in ("image_width", "image_height"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not float(v).is_integer() or int(v) < 1:
+                raise ValueError(f"{name} must be a positive integer, got {v!r}")
+            setattr(self, name, int(v))
+        rms = float(self.rms)
+        if not np.isfinite(rms) or rms < 0:
+            raise ValueError(f"rms must be a finite number >= 0, got {self.rms!r}")
+        self.rms = rms
+        for name in ("M1", "M2"):
+            m = getattr(self, name)
+            if not (m[0, 0] > 0 and m[1, 1] > 0 and abs(m[2, 2] - 1) < 1e-9
+                    and np.abs(m[[1, 2, 2], [0, 0, 1]]).max() < 1e-9):
+                raise ValueError(f"{name} is not a camera matrix [[fx s cx] [0 fy cy] [0 0 1]] with fx, fy > 0")
+        if np.linalg.norm(self.T) == 0:
+            raise ValueError("T is zero: the two cameras must not coincide")
+
+    @property
+    def image_size(self) -> tuple[int, int]:
+        """``(width, height)`` as OpenCV wants sizes."""
+        return (self.image_width, self.image_height)
+
+    @property
+    def baseline(self) -> float:
+        """Distance between the optical centres, in the units of ``T``."""
+        return float(np.linalg.norm(self.T))
+
+
+def _as_matrix(a: Any, shape: tuple[int, int], name: str) -> np.ndarray:
+    try:
+        m = np.array(a, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} is not a numeric matrix") from None
+    if m.shape != shape:
+        raise ValueError(f"{name} must be {shape[0]}x{shape[1]}, got shape {m.shape}")
+    if not np.all(np.isfinite(m)):
+        raise ValueError(f"{name} contains NaN or infinite values")
+    return m
+
+
+def _as_dist(a: Any, name: str) -> np.ndarray:
+    try:
+        d = np.array(a, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} is not a numeric vector") from None
+    if d.ndim > 2 or (d.ndim == 2 and 1 not in d.shape):
+        raise ValueError(f"{name} must be a vector (1xN or Nx1), got shape {d.shape}")
+    d = d.ravel()
+    if d.size not in DIST_LENGTHS:
+        raise ValueError(f"{name} must have 4, 5, 8, 12 or 14 coefficients, got {d.size}")
+    if not np.all(np.isfinite(d)):
+        raise ValueError(f"{name} contains NaN or infinite values")
+    return d
+
+
+def _as_vector3(a: Any, name: str) -> np.ndarray:
+    try:
+        v = np.array(a, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} is not a numeric vector") from None
+    if v.size != 3 or (v.ndim == 2 and 1 not in v.shape) or v.ndim > 2:
+        raise ValueError(f"{name} must have 3 elements (3x1 or 1x3), got shape {v.shape}")
+    v = v.ravel()
+    if not np.all(np.isfinite(v)):
+        raise ValueError(f"{name} contains NaN or infinite values")
+    return v
+
+
+def _as_rotation(a: Any, name: str) -> np.ndarray:
+    try:
+        r = np.array(a, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} is not a numeric matrix") from None
+    if r.size == 3 and r.ndim <= 2:  # a rotation vector (Rodrigues), as some tools store it
+        r = cv2.Rodrigues(_as_vector3(r, name))[0]
+    if r.shape != (3, 3):
+        raise ValueError(f"{name} must be a 3x3 rotation matrix (or a 3-element rotation vector), got shape {r.shape}")
+    if not np.all(np.isfinite(r)):
+        raise ValueError(f"{name} contains NaN or infinite values")
+    if np.abs(r @ r.T - np.eye(3)).max() > 1e-6 or np.linalg.det(r) < 0:
+        raise ValueError(f"{name} is not a rotation matrix (R R^T != I or det(R) < 0)")
+    return r
+
+
+# --------------------------------------------------------------------------------------------------
+# YAML
+
+
+def write_yaml(calib: StereoCalibration, path: str | os.PathLike[str]) -> None:
+    """Store ``calib`` as an OpenCV FileStorage file (YAML unless ``path`` ends in .xml/.json).
+
+    Keys: ``M1, D1, M2, D2, R`` (``!!opencv-matrix``, D as 1xN), ``T`` (3x1), ``image_width``,
+    ``image_height`` (integers), ``rms`` (real). Written atomically.
+    """
+    with atomic_output(path, suffix=Path(path).suffix or ".yml") as tmp:
+        fs = cv2.FileStorage(str(tmp), cv2.FILE_STORAGE_WRITE)
+        if not fs.isOpened():
+            raise ValueError(f"cannot open {path} for writing")
+        try:
+            fs.write("M1", calib.M1)
+            fs.write("D1", calib.D1.reshape(1, -1))
+            fs.write("M2", calib.M2)
+            fs.write("D2", calib.D2.reshape(1, -1))
+            fs.write("R", calib.R)
+            fs.write("T", calib.T.reshape(3, 1))
+            fs.write("image_width", int(calib.image_width))
+            fs.write("image_height", int(calib.image_height))
+            fs.write("rms", float(calib.rms))
+        finally:
+            fs.release()
+
+
+def read_yaml(path: str | os.PathLike[str]) -> StereoCalibration:
+    """Read a calibration file written by :func:`write_yaml` or by other tools.
+
+    Matrices may be ``!!opencv-matrix`` nodes or plain sequences; D may be 1xN or Nx1 (N = 4, 5, 8,
+    12, 14), T 3x1 or 1x3, R a 3x3 matrix or a rotation vector. Anything missing or malformed raises
+    a ``ValueError`` with a one-line message naming the file and the key.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise ValueError(f"calibration file {p} does not exist")
+    try:
+        fs = cv2.FileStorage(str(p), cv2.FILE_STORAGE_READ)
+    except cv2.error:
+        fs = None
+    if fs is None or not fs.isOpened():
+        raise ValueError(f"{p} is not an OpenCV YAML/XML calibration file (cannot parse it)")
+    try:
+        values: dict[str, Any] = {}
+        for key in YAML_KEYS:
+            node = fs.getNode(key)
+            if node.empty() or node.isNone():
+                raise ValueError(f"{p}: key '{key}' is missing")
+            values[key] = _read_node(node, key, p)
+    finally:
+        fs.release()
+    try:
+        return StereoCalibration(**values)
+    except ValueError as e:
+        raise ValueError(f"{p}: {e}") from None
+
+
+def _read_node(node: Any, key: str, p: Path) -> Any:
+    if key in ("image_width", "image_height", "rms"):
+        if not (node.isInt() or node.isReal()):
+            raise ValueError(f"{p}: key '{key}' must be a number")
+        return node.real()
+    if node.isMap():
+        mat = node.mat()
+        if mat is None:
+            raise ValueError(f"{p}: key '{key}' is not a matrix")
+        return np.asarray(mat, dtype=np.float64)
+    if node.isSeq():
+        vals = []
+        for i in range(node.size()):
+            item = node.at(i)
+            if item.isSeq():  # nested rows
+                row = []
+                for j in range(item.size()):
+                    sub = item.at(j)
+                    if not (sub.isInt() or sub.isReal()):
+                        raise ValueError(f"{p}: key '{key}' holds a non-number")
+                    row.append(sub.real())
+                vals.append(row)
+            elif item.isInt() or item.isReal():
+                vals.append(item.real())
+            else:
+                raise ValueError(f"{p}: key '{key}' holds a non-number")
+        try:
+            arr = np.array(vals, dtype=np.float64)
+        except ValueError:
+            raise ValueError(f"{p}: key '{key}' has rows of different lengths") from None
+        if key in ("M1", "M2", "R") and arr.ndim == 1 and arr.size == 9:
+            arr = arr.reshape(3, 3)
+        return arr
+    raise ValueError(f"{p}: key '{key}' must be a matrix or a sequence of numbers")
+
+
+# --------------------------------------------------------------------------------------------------
+# Corner detection
+
+
+def parse_board(text: str) -> tuple[int, int]:
+    """``"9x6"`` -> ``(9, 6)``: inner corners per row and per column, each at least 2."""
+    m = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", str(text))
+    if m is None:
+        raise ValueError(f"board must be COLSxROWS inner corners, e.g. 9x6; got {text!r}")
+    cols, rows = int(m.group(1)), int(m.group(2))
+    if cols < 2 or rows < 2 or cols > 100 or rows > 100:
+        raise ValueError(f"board needs 2..100 inner corners per side, got {cols}x{rows}")
+    if cols == rows:
+        raise ValueError(f"a square board ({cols}x{rows}) has an ambiguous orientation; use e.g. 9x6")
+    return cols, rows
+
+
+def board_object_points(board: tuple[int, int], square: float) -> np.ndarray:
+    """The board's inner corners in its own frame (z = 0), in OpenCV's row-major corner order."""
+    cols, rows = board
+    if not square > 0:
+        raise ValueError(f"square size must be > 0, got {square}")
+    obj = np.zeros((rows * cols, 3), np.float32)
+    obj[:, :2] = np.mgrid[0:cols, 0:rows].T.reshape(-1, 2) * square
+    return obj
+
+
+def find_corners(gray: np.ndarray, board: tuple[int, int]) -> np.ndarray | None:
+    """Sub-pixel inner corners ``(N, 1, 2)`` float32 of ``board`` in a grey image, or None.
+
+    The ``cornerSubPix`` half-window is 40 % of the smallest corner spacing, clipped to 3..11 px, so
+    small boards (the 352x288 EyeBot images) do not pull neighbouring corners into the window.
+    """
+    gray = np.asarray(gray)
+    if gray.ndim != 2 or gray.dtype != np.uint8:
+        raise ValueError(f"find_corners wants a 2-D uint8 grey image, got {gray.dtype} {gray.shape}")
+    flags = cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE
+    ok, corners = cv2.findChessboardCorners(gray, board, flags=flags)
+    if not ok or corners is None or len(corners) != board[0] * board[1]:
+        return None
+    grid = corners.reshape(board[1], board[0], 2)
+    spacing = min(np.linalg.norm(np.diff(grid, axis=0), axis=2).min(),
+                  np.linalg.norm(np.diff(grid, axis=1), axis=2).min())
+    half = int(np.clip(round(0.4 * spacing), 3, 11))
+    return cv2.cornerSubPix(gray, corners, (half, half), (-1, -1), _SUBPIX_CRITERIA)
+
+
+def expand_images(spec: str | os.PathLike[str] | Sequence[Any], side: str) -> list[Any]:
+    """A glob pattern -> sorted list of paths (ValueError if none); sequences are returned as lists."""
+    if isinstance(spec, (str, os.PathLike)):
+        paths = sorted(_glob.glob(os.fspath(spec)))
+        if not paths:
+            raise ValueError(f"no {side} images match {os.fspath(spec)!r}")
+        return paths
+    items = list(spec)
+    if not items:
+        raise ValueError(f"no {side} images given")
+    return items
+
+
+def _load_gray(item: Any) -> tuple[np.ndarray, str]:
+    if isinstance(item, np.ndarray):
+        img = item
+        name = "<array>"
+    else:
+        name = os.fspath(item)
+        if not os.path.isfile(name):
+            raise ValueError(f"image {name} does not exist")
+        img = cv2.imread(name, cv2.IMREAD_UNCHANGED)
+        if img is None:
+            raise ValueError(f"cannot read image {name} (not an image file?)")
+    if img.ndim == 3:
+        img = cv2.cvtColor(img, cv2.COLOR_BGRA2GRAY if img.shape[2] == 4 else cv2.COLOR_BGR2GRAY)
+    if img.ndim != 2:
+        raise ValueError(f"image {name} is not a grey or colour image (shape {img.shape})")
+    if img.dtype != np.uint8:
+        if img.dtype == np.uint16:
+            img = (img >> 8).astype(np.uint8)
+        else:
+            raise ValueError(f"image {name} has unsupported pixel type {img.dtype}")
+    return img, name
+
+
+# --------------------------------------------------------------------------------------------------
+# Calibration
+
+
+def calibrate_stereo(left: str | Sequence[Any], right: str | Sequence[Any], *,
+                     board: tuple[int, int] = (9, 6), square: float = 0.025, refine: bool = True,
+                     log: Callable[[str], None] | None = None,
+                     progress: bool | None = None) -> StereoCalibration:
+    """Calibrate a stereo rig from chessboard image pairs.
+
+    ``left``/``right``: glob patterns (sorted, paired in order), lists of paths or lists of grey
+    uint8 arrays. ``board``: inner corners (cols, rows); ``square``: square size (the unit of ``T``).
+    ``refine``: refine the intrinsics in the stereo step (default) or keep the per-camera ones.
+    ``log`` receives one line per skipped pair. Raises ValueError on unreadable images, mixed image
+    sizes, unequal list lengths, or fewer than 3 pairs with the board found in both images.
+    """
+    lefts = expand_images(left, "left")
+    rights = expand_images(right, "right")
+    if len(lefts) != len(rights):
+        raise ValueError(f"{len(lefts)} left images but {len(rights)} right images: they must pair up")
+    obj = board_object_points(board, square)
+    objpoints: list[np.ndarray] = []
+    pts_l: list[np.ndarray] = []
+    pts_r: list[np.ndarray] = []
+    used: list[tuple[str, str]] = []
+    skipped: list[tuple[str, str, str]] = []
+    size: tuple[int, int] | None = None
+    with Progress(len(lefts), "chessboard corners", force=progress) as bar:
+        for a, b in zip(lefts, rights):
+            (ga, na), (gb, nb) = _load_gray(a), _load_gray(b)
+            for g, n in ((ga, na), (gb, nb)):
+                s = (g.shape[1], g.shape[0])
+                if size is None:
+                    size = s
+                elif s != size:
+                    raise ValueError(f"image {n} is {s[0]}x{s[1]} but the first image is {size[0]}x{size[1]}")
+            ca, cb = find_corners(ga, board), find_corners(gb, board)
+            bar.update()
+            if ca is None or cb is None:
+                where = "either image" if ca is None and cb is None else ("the left image" if ca is None else "the right image")
+                reason = f"{board[0]}x{board[1]} board not found in {where}"
+                skipped.append((na, nb, reason))
+                if log is not None:
+                    log(f"skipped pair {Path(na).name} / {Path(nb).name}: {reason}")
+                continue
+            # findChessboardCorners may start at either end of the (180-degree symmetric) grid;
+            # the two views of one pair must list the corners in the same order.
+            va, vb = ca[-1, 0] - ca[0, 0], cb[-1, 0] - cb[0, 0]
+            if float(np.dot(va, vb)) < 0:
+                cb = cb[::-1].copy()
+            objpoints.append(obj)
+            pts_l.append(ca)
+            pts_r.append(cb)
+            used.append((na, nb))
+    if len(used) < 3:
+        raise ValueError(f"the {board[0]}x{board[1]} board was found in both images of only {len(used)} "
+                         f"of {len(lefts)} pairs; at least 3 are needed")
+    assert size is not None
+    rms1, m1, d1, _, _ = cv2.calibrateCamera(objpoints, pts_l, size, None, None, criteria=_CALIB_CRITERIA)
+    rms2, m2, d2, _, _ = cv2.calibrateCamera(objpoints, pts_r, size, None, None, criteria=_CALIB_CRITERIA)
+    flags = cv2.CALIB_USE_INTRINSIC_GUESS if refine else cv2.CALIB_FIX_INTRINSIC
+    rms, m1, d1, m2, d2, r, t, _, _ = cv2.stereoCalibrate(
+        objpoints, pts_l, pts_r, m1, d1, m2, d2, size, flags=flags, criteria=_CALIB_CRITERIA)
+    if not np.isfinite(rms):
+        raise ValueError("stereo calibration did not converge")
+    calib = StereoCalibration(m1, d1, m2, d2, r, t, size[0], size[1], rms)
+    calib.info.update(used=used, skipped=skipped, rms_left=float(rms1), rms_right=float(rms2),
+                      refine=refine, board=tuple(board), square=float(square),
+                      points_left=pts_l, points_right=pts_r)
+    return calib
