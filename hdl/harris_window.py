@@ -18,9 +18,10 @@ LATENCY = 8  # 1 product stage + the window's N + 2
 def harris_window(clk, rst, sink, source, *, width: int = 352, height: int = 288):
     """Structure-tensor sums: ``source`` pixel (x, y) = (Sxy, Syy, Sxx) over the 5x5 window centred on (x, y).
 
-    Each incoming (Ix, Iy) pair is squared and multiplied first (3 multipliers), each product floored
-    by 8 and saturated to 12 bits (ufix[12,-9], ufix[12,-9], sfix[12,-9]; Sobel codes never saturate),
-    and the three are packed into one 36-bit word, so a single set of four line delays (one RAMB16
+    Each incoming (Ix, Iy) pair is squared and multiplied first (3 multipliers of 10 x 10 bits: each
+    code c enters as 2c + 1, the midpoint of the gradients it stands for), each product rounded by 32
+    and saturated to 12 bits (ufix[12,-9], ufix[12,-9], sfix[12,-9]; Sobel codes never saturate), and
+    the three are packed into one 36-bit word, so a single set of four line delays (one RAMB16
     each) carries them. The separable weighted sum [1 2 4 2 1] x [1 2 4 2 1] runs by shifts and adds
     on the unpacked taps; its "/128" is a move of the binary point, so no bit is dropped: Sxx, Syy are
     ufix[19,-2], Sxy sfix[19,-2]. Pixels within 2 of the border carry unspecified data.
@@ -35,7 +36,7 @@ def harris_window(clk, rst, sink, source, *, width: int = 352, height: int = 288
 
     Latency: 8 clocks after input pixel (x + 2, y + 2): 2 lines + 2 pixels + 8 clocks.
 
-    Resources: 3 multipliers (9x9), 4 line delays of 36 bits (4 RAMB16), adders and registers.
+    Resources: 3 multipliers (10x10), 4 line delays of 36 bits (4 RAMB16), adders and registers.
     """
     check_geometry(width, height, min_size=N)
     if len(sink.data) != 18:
@@ -43,9 +44,10 @@ def harris_window(clk, rst, sink, source, *, width: int = 352, height: int = 288
     if len(source.data) != model.OUT_BITS:
         raise ValueError(f"harris_window source carries {model.OUT_BITS} bits, has {len(source.data)}")
 
-    ix = fx_signal(sfix(9))
-    iy = fx_signal(sfix(9))
-    fxx, fyy, fxy = _sig(0, 65536), _sig(0, 65536), _sig(-65280, 65536)
+    mx = fx_signal(sfix(10))  # 2 Ix + 1
+    my = fx_signal(sfix(10))
+    big = 511 * 511
+    fxx, fyy, fxy = _sig(0, big + 16), _sig(0, big + 16), _sig(-big + 16, big + 16)
     qxx, qyy = fx_signal(model.PROD_SQ), fx_signal(model.PROD_SQ)
     qxy = fx_signal(model.PROD_XY)
     sq_top = model.PROD_SQ.hi
@@ -53,32 +55,33 @@ def harris_window(clk, rst, sink, source, *, width: int = 352, height: int = 288
 
     @always_comb
     def fields():
-        ix.next = sink.data[9:]
-        iy.next = sink.data[18:9]
+        mx.next = concat(sink.data[9:0], True)
+        my.next = concat(sink.data[18:9], True)
 
+    # The +16 rounds the cut by 32 below; it rides on the multiplier's output adder.
     @always_comb
     def multiply():
-        fxx.next = ix * ix
-        fyy.next = iy * iy
-        fxy.next = ix * iy
+        fxx.next = mx * mx + 16
+        fyy.next = my * my + 16
+        fxy.next = mx * my + 16
 
-    # Floor by 8, then clamp: only inputs outside the Sobel's range can reach the clamps.
+    # Only inputs outside the Sobel's range can reach the clamps.
     @always_comb
     def saturate():
-        if (fxx >> 3) > sq_top:
+        if (fxx >> 5) > sq_top:
             qxx.next = sq_top
         else:
-            qxx.next = fxx >> 3
-        if (fyy >> 3) > sq_top:
+            qxx.next = fxx >> 5
+        if (fyy >> 5) > sq_top:
             qyy.next = sq_top
         else:
-            qyy.next = fyy >> 3
-        if (fxy >> 3) > xy_hi:
+            qyy.next = fyy >> 5
+        if (fxy >> 5) > xy_hi:
             qxy.next = xy_hi
-        elif (fxy >> 3) < xy_lo:
+        elif (fxy >> 5) < xy_lo:
             qxy.next = xy_lo
         else:
-            qxy.next = fxy >> 3
+            qxy.next = fxy >> 5
 
     prod = ImageStream(model.PACK_BITS)
 

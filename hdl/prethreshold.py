@@ -50,6 +50,9 @@ def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: i
     if len(thr_addr) < abits:
         raise ValueError(f"thr_addr needs {abits} bits for {nblk} blocks, has {len(thr_addr)}")
 
+    if nblk == 1:
+        return global_threshold(clk, rst, sink, source, thr_we, thr_data)
+
     # Last column / row of each block, as ROM tables indexed by the block counters.
     x_last = tuple(int(e) - 1 for e in block_edges(width, bxn)[1:])
     y_last = tuple(int(e) - 1 for e in block_edges(height, byn)[1:])
@@ -133,3 +136,33 @@ def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: i
             source.data.next = 0
 
     return ram, flags, lookup, read, choose, position, emit
+
+
+@block
+def global_threshold(clk, rst, sink, source, thr_we, thr_data):
+    """blocks=(1, 1): one threshold register, no position counters."""
+    thr = fx_signal(corner_model.OUT)
+    value = fx_signal(corner_model.OUT)
+    stored = Signal(intbv(0)[len(thr_data):])
+
+    @always_seq(clk.posedge, reset=rst)
+    def register():
+        if thr_we:
+            stored.next = thr_data
+
+    @always_comb
+    def signed_view():
+        value.next = sink.data
+        thr.next = stored
+
+    @always_seq(clk.posedge, reset=rst)
+    def emit():
+        source.valid.next = sink.valid
+        source.eol.next = sink.eol
+        source.eof.next = sink.eof
+        if value > thr:
+            source.data.next = sink.data
+        else:
+            source.data.next = 0
+
+    return register, signed_view, emit

@@ -19,7 +19,26 @@ from eyestereo.hdl.catalog import BLOCKS
 from eyestereo.hdl.convert import convert
 
 #: Thesis Tables 6.1/6.3 (Xilinx ISE, Spartan-3E 500): LUTs, block RAMs, multipliers.
-THESIS = {"sobel": (259, 2, 0)}
+THESIS = {"sobel": (259, 2, 0), "harris_window": (843, 4, 3), "cornerness": (132, 0, 5),
+          "prethreshold": (197, 0, 0), "prethreshold 1x1": (20, 0, 0), "nms": (381, 2, 0),
+          "nms 5x5": (706, 4, 0), "nms 1x1": (7, 0, 0)}
+
+#: Configurations beyond each block's default that the report also synthesizes: (label, block, params).
+VARIANTS = [
+    ("prethreshold 1x1", "prethreshold", dict(blocks=(1, 1))),
+    ("nms 1x1", "nms", dict(size=1)),
+    ("nms 5x5", "nms", dict(size=5)),
+    ("harris_mono nms 5x5", "harris_mono", dict(nms=5)),
+]
+
+
+def configurations(names=None) -> list[tuple[str, str, dict]]:
+    """(label, block, params) of every default configuration and variant, in report order."""
+    out = []
+    for n in names or list(BLOCKS):
+        out.append((n, n, {}))
+        out += [v for v in VARIANTS if v[1] == n]
+    return out
 
 CATEGORIES = {
     "LUT": re.compile(r"^LUT[1-6]$"),
@@ -62,9 +81,10 @@ def summarize(cells: dict[str, int]) -> dict[str, int]:
     return out
 
 
-def synth_block(name: str, out: Path, **params) -> dict:
+def synth_block(name: str, out: Path, *, label: str | None = None, **params) -> dict:
     """Synthesize one block; returns its summary, raw cell counts and the paths used."""
-    d = Path(out) / name
+    label = label or name
+    d = Path(out) / re.sub(r"[^A-Za-z0-9_.-]+", "_", label)
     d.mkdir(parents=True, exist_ok=True)
     (vfile,) = convert(name, d, hdl="Verilog", **params)
     stat = d / "stat.txt"
@@ -76,7 +96,9 @@ def synth_block(name: str, out: Path, **params) -> dict:
     if r.returncode != 0 or not stat.exists():
         raise RuntimeError(f"yosys failed on {name} (see {log}):\n{r.stdout[-2000:]}{r.stderr[-2000:]}")
     cells = parse_stat(stat.read_text())
-    return dict(block=name, params=params, summary=summarize(cells), cells=cells)
+    return dict(block=name, label=label, params={k: (list(v) if isinstance(v, tuple) else v)
+                                                 for k, v in params.items()},
+                summary=summarize(cells), cells=cells)
 
 
 def table(results: list[dict]) -> str:
@@ -85,9 +107,10 @@ def table(results: list[dict]) -> str:
              "|---|---:|---:|---:|---:|---:|---:|---|"]
     for r in results:
         s = r["summary"]
-        th = THESIS.get(r["block"])
+        label = r.get("label", r["block"])
+        th = THESIS.get(label)
         ths = f"{th[0]} / {th[1]} / {th[2]}" if th else "-"
-        lines.append(f"| {r['block']} | {s['LUT']} | {s['LUTRAM']} | {s['FF']} | {s['RAMB16']} | "
+        lines.append(f"| {label} | {s['LUT']} | {s['LUTRAM']} | {s['FF']} | {s['RAMB16']} | "
                      f"{s['MULT18X18']} | {s['carry']} | {ths} |")
     lines += ["", "LUTs are 4-input LUTs; carry cells (MUXCY/XORCY) sit in the slices' carry chains and use no LUT.",
               "Thesis figures: Xilinx ISE 10 on the Spartan-3E 500 (Tables 6.1 and 6.3)."]
@@ -99,14 +122,14 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default="build/synth", type=Path)
     ap.add_argument("--block", action="append", help="only this block (repeatable)")
     args = ap.parse_args(argv)
-    names = args.block or list(BLOCKS)
     try:
-        results = []
-        for n in names:
+        for n in args.block or []:
             if n not in BLOCKS:
                 raise ValueError(f"unknown block {n!r}; blocks are {sorted(BLOCKS)}")
-            print(f"synthesizing {n} ...", flush=True)
-            results.append(synth_block(n, args.out))
+        results = []
+        for label, n, params in configurations(args.block):
+            print(f"synthesizing {label} ...", flush=True)
+            results.append(synth_block(n, args.out, label=label, **params))
     except (RuntimeError, ValueError) as e:
         print(f"make synth: {e}", file=sys.stderr)
         return 1

@@ -30,7 +30,7 @@ def make_frame(spec: str, width: int, height: int, bits: int = 8) -> np.ndarray:
     """A stimulus frame of stream words.
 
     Images (8-bit): ``random:SEED``, ``ramp``, ``file:NAME`` (from tests/data, centre crop), ``pattern:SEED``
-    (the corner test pattern). Random words of other widths: ``random:SEED`` uses ``bits``.
+    and ``checker:SEED`` (the corner test patterns of :mod:`eyestereo.tools.testpattern`, blur 0.5). Random words of other widths: ``random:SEED`` uses ``bits``.
     Inputs for later stages, built with the bit-true models from an image spec after the colon:
     ``sobel:IMG`` (Sobel words), ``window:IMG`` (harris_window words), ``corner:K:IMG`` (cornerness
     words for k code K). Random inputs over a stage's full range: ``grad:SEED:LIM`` (Sobel words with
@@ -54,10 +54,11 @@ def make_frame(spec: str, width: int, height: int, bits: int = 8) -> np.ndarray:
         y0 = (img.shape[0] - height) // 2
         x0 = (img.shape[1] - width) // 2
         return img[y0:y0 + height, x0:x0 + width].astype(np.int64)
-    if kind == "pattern":
-        from eyestereo.tools.testpattern import corner_pattern
+    if kind in ("pattern", "checker"):
+        from eyestereo.tools.testpattern import checkerboard_pattern, corner_pattern
 
-        return corner_pattern(width, height, seed=int(arg)).image.astype(np.int64)
+        gen = corner_pattern if kind == "pattern" else checkerboard_pattern
+        return gen(width, height, seed=int(arg), blur=0.5).image.astype(np.int64)
     if kind == "sobel":
         return sobel.pack(*sobel.sobel(make_frame(arg, width, height))[:2])
     if kind == "window":

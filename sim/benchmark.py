@@ -123,9 +123,9 @@ def main(argv=None) -> int:
         print(f"benchmark: {case[0]} ...", flush=True)
         results.append(measure(case))
     resources = []
-    for name in synth.BLOCKS:
-        print(f"benchmark: synthesizing {name} ...", flush=True)
-        resources.append(synth.synth_block(name, BUILD.parent / "synth"))
+    for label, name, params in synth.configurations():
+        print(f"benchmark: synthesizing {label} ...", flush=True)
+        resources.append(synth.synth_block(name, BUILD.parent / "synth", label=label, **params))
     text = report(results, resources)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(text)

@@ -85,10 +85,21 @@ def atomic_output(path: str | os.PathLike[str], suffix: str | None = None) -> It
         yield tmp_path
         if not tmp_path.exists() or tmp_path.stat().st_size == 0:
             raise ValueError(f"writing {target} produced no data")
+        os.chmod(tmp_path, _file_mode(target))
         os.replace(tmp_path, target)
     finally:
         with contextlib.suppress(FileNotFoundError):
             tmp_path.unlink()
+
+
+def _file_mode(target: Path) -> int:
+    """The mode a plainly created file would get (mkstemp makes 0600): the old file's, else 0666 & ~umask."""
+    try:
+        return target.stat().st_mode & 0o777
+    except OSError:
+        mask = os.umask(0o022)
+        os.umask(mask)
+        return 0o666 & ~mask
 
 
 def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
@@ -220,12 +231,13 @@ def _as_rotation(a: Any, name: str) -> np.ndarray:
 
 
 def write_yaml(calib: StereoCalibration, path: str | os.PathLike[str]) -> None:
-    """Store ``calib`` as an OpenCV FileStorage file (YAML unless ``path`` ends in .xml/.json).
+    """Store ``calib`` as an OpenCV FileStorage file (YAML unless ``path`` ends in .xml or .json).
 
     Keys: ``M1, D1, M2, D2, R`` (``!!opencv-matrix``, D as 1xN), ``T`` (3x1), ``image_width``,
     ``image_height`` (integers), ``rms`` (real). Written atomically.
     """
-    with atomic_output(path, suffix=Path(path).suffix or ".yml") as tmp:
+    suffix = Path(path).suffix.lower()
+    with atomic_output(path, suffix=suffix if suffix in (".yml", ".yaml", ".xml", ".json") else ".yml") as tmp:
         fs = cv2.FileStorage(str(tmp), cv2.FILE_STORAGE_WRITE)
         if not fs.isOpened():
             raise ValueError(f"cannot open {path} for writing")
@@ -255,7 +267,7 @@ def read_yaml(path: str | os.PathLike[str]) -> StereoCalibration:
         raise ValueError(f"calibration file {p} does not exist")
     try:
         fs = cv2.FileStorage(str(p), cv2.FILE_STORAGE_READ)
-    except cv2.error:
+    except (cv2.error, SystemError):  # OpenCV's parser reports syntax errors either way
         fs = None
     if fs is None or not fs.isOpened():
         raise ValueError(f"{p} is not an OpenCV YAML/XML calibration file (cannot parse it)")
@@ -280,7 +292,10 @@ def _read_node(node: Any, key: str, p: Path) -> Any:
             raise ValueError(f"{p}: key '{key}' must be a number")
         return node.real()
     if node.isMap():
-        mat = node.mat()
+        try:
+            mat = node.mat()
+        except (cv2.error, SystemError):
+            raise ValueError(f"{p}: key '{key}' is a malformed matrix (rows x cols != number of values)") from None
         if mat is None:
             raise ValueError(f"{p}: key '{key}' is not a matrix")
         return np.asarray(mat, dtype=np.float64)

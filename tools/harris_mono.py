@@ -84,6 +84,12 @@ def features(flags: np.ndarray, mask: np.ndarray | None = None) -> np.ndarray:
 
 def harris_float(img: np.ndarray, k: float) -> np.ndarray:
     """Float64 cornerness with the hardware's kernels and no quantization (border: 0)."""
+    det, trace = harris_float_terms(img)
+    return det - k * trace ** 2
+
+
+def harris_float_terms(img: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(det M, trace M) of the float64 structure tensor (border: 0), M as in the module doc."""
     import cv2
 
     img = np.asarray(img, np.float64)
@@ -93,11 +99,12 @@ def harris_float(img: np.ndarray, k: float) -> np.ndarray:
     mxx = cv2.filter2D(gx * gx, -1, kern, borderType=cv2.BORDER_REPLICATE)
     myy = cv2.filter2D(gy * gy, -1, kern, borderType=cv2.BORDER_REPLICATE)
     mxy = cv2.filter2D(gx * gy, -1, kern, borderType=cv2.BORDER_REPLICATE)
-    c = mxx * myy - mxy * mxy - k * (mxx + myy) ** 2
     r = SOBEL_RADIUS + _window.RADIUS
-    out = np.zeros_like(c)
-    out[r:-r, r:-r] = c[r:-r, r:-r]
-    return out
+    det = np.zeros_like(mxx)
+    trace = np.zeros_like(mxx)
+    det[r:-r, r:-r] = (mxx * myy - mxy * mxy)[r:-r, r:-r]
+    trace[r:-r, r:-r] = (mxx + myy)[r:-r, r:-r]
+    return det, trace
 
 
 def float_features(img: np.ndarray, k: float, threshold: float | np.ndarray, *, blocks=(1, 1),

@@ -14,7 +14,8 @@ The construction, for each camera ``i`` (left = 1, right = 2):
    ``v2 = (-t_y, t_x, 0)/sqrt(t_x^2 + t_y^2)``, ``v3 = v1 x v2`` (thesis eqs. 3.3-3.5), with both
    ``v1`` and ``v2`` multiplied by the sign of ``t_x`` so that the images stay upright (without it a
    right camera at ``t_x < 0``, OpenCV's convention, gets images turned by 180 degrees). The two differ
-   by a small rotation about the baseline when ``t`` has a z component. The camera rotations are
+   only by a rotation about the baseline, tiny for a nearly ideal rig (1e-5 rad for the synthetic
+   one), because the thesis's ``v2`` has no z component. The camera rotations are
    ``R1 = R_rect r^T`` and ``R2 = R_rect r``.
 3. **Common camera matrix** ``K = [[f, 0, cx], [0, f, cy], [0, 0, 1]]`` of both rectified images.
    ``focal="mean"`` (default) takes the mean of the two vertical focal lengths ``fy`` (as OpenCV's
@@ -24,7 +25,8 @@ The construction, for each camera ``i`` (left = 1, right = 2):
    iteration), then the **mean of the two** for both cameras (zero disparity at infinity; the thesis's
    "mean value between both principal points", OpenCV's ``CALIB_ZERO_DISPARITY``). For an output size
    different from the calibrated one, ``f`` scales with the height ratio and ``cx, cy`` with the width
-   and height ratios (as OpenCV does).
+   and height ratios, so the rectified image is an exactly scaled copy (OpenCV instead centres the
+   corners with the scaled ``f`` around the unscaled image centre, which moves the image).
 4. **Backward mapping** of each rectified pixel ``p``: ray ``K^-1 p``, rotated back by ``R_i^T``,
    normalised by its z, distorted by camera ``i``'s lens model and projected with its camera matrix
    ``M_i`` (including the skew term ``M_i[0, 1]``, which OpenCV's own functions ignore; it is 0 for
@@ -38,9 +40,10 @@ The lens model (thesis 3.3, Slama/Heikkila/Bouguet; OpenCV's order of coefficien
 
 ``method="opencv"`` computes the same maps with ``cv2.stereoRectify`` (``CALIB_ZERO_DISPARITY``,
 ``alpha=-1``: OpenCV's own choice of ``f`` = mean ``fy`` and of the principal point, no extra scaling)
-and ``cv2.initUndistortRectifyMap`` (``CV_32FC1``). The two paths differ only in how precisely the four
-image corners are undistorted for the principal point (OpenCV: 5 fixed-point iterations in float32)
-and in the maps' float32 rounding; docs/toolbox.md gives the measured difference.
+and ``cv2.initUndistortRectifyMap`` (``CV_32FC1``). At the calibrated size the two paths differ only in how
+precisely the four image corners are undistorted for the principal point (OpenCV: a few fixed-point
+iterations, in float32) and in the maps' float32 rounding; docs/toolbox.md gives the measured
+difference.
 """
 
 from __future__ import annotations
@@ -48,7 +51,7 @@ from __future__ import annotations
 import io
 import os
 import zipfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -64,6 +67,7 @@ __all__ = [
     "MAP_KEYS",
     "Maps",
     "backward_map",
+    "compare_up_to_frame",
     "compute_maps",
     "distort",
     "ground_truth_maps",
@@ -73,6 +77,7 @@ __all__ = [
     "rectified_camera",
     "rectify_points",
     "rectify_rotations",
+    "row_alignment",
     "save_maps",
     "undistort",
 ]
@@ -267,7 +272,6 @@ class Maps:
     image_width: int | None = None
     image_height: int | None = None
     method: str = ""
-    extra: dict[str, Any] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
         shape = None
@@ -363,6 +367,60 @@ def rectify_points(points: np.ndarray, M: np.ndarray, D: np.ndarray, R_i: np.nda
     xu, yu = undistort(xn, yn, D)
     ray = (np.asarray(K, dtype=np.float64) @ np.asarray(R_i, dtype=np.float64)) @ np.vstack([xu, yu, np.ones_like(xu)])
     return (ray[:2] / ray[2]).T
+
+
+def compare_up_to_frame(maps: Maps, truth: StereoCalibration, mask: dict[str, np.ndarray] | None = None,
+                        ) -> dict[str, float]:
+    """How well ``maps`` match the true cameras, ignoring the choice of rectified frame.
+
+    A calibration fixes the rectified frame (rotation and common camera matrix) only as well as it
+    knows the baseline direction, focal lengths and principal points; a few tenths of a pixel of
+    difference there move the whole rectified image without harming it. So each source point of
+    ``maps`` is sent through the *true* camera into the true rectified frame, the best homography from
+    the rectified pixel grid onto those points is fitted (least squares), and what it cannot explain
+    -- lens-model error -- is reported in pixels: ``{side}_mean``, ``{side}_max`` and ``mean``,
+    ``max`` over both; ``{side}_raw_mean`` is the plain distance before the homography.
+    """
+    R1, R2 = rectify_rotations(truth.R, truth.T)
+    K = rectified_camera(truth, R1, R2, (maps.width, maps.height))
+    out: dict[str, float] = {}
+    both = []
+    for side, M, D, Ri in (("left", truth.M1, truth.D1, R1), ("right", truth.M2, truth.D2, R2)):
+        mx, my = maps.side(side)
+        m = np.isfinite(mx) & np.isfinite(my)
+        if mask is not None:
+            m &= np.asarray(mask[side], dtype=bool)
+        yy, xx = np.nonzero(m)
+        if len(xx) < 8:
+            raise ValueError(f"too few {side} pixels to compare ({len(xx)})")
+        p = np.stack([xx, yy], axis=1).astype(np.float64)
+        q = rectify_points(np.stack([mx[yy, xx], my[yy, xx]], axis=1), M, D, Ri, K)
+        H, _ = cv2.findHomography(p, q, 0)
+        ph = cv2.perspectiveTransform(p.reshape(-1, 1, 2), H).reshape(-1, 2)
+        r = np.linalg.norm(ph - q, axis=1)
+        out[f"{side}_mean"] = float(r.mean())
+        out[f"{side}_max"] = float(r.max())
+        out[f"{side}_raw_mean"] = float(np.linalg.norm(p - q, axis=1).mean())
+        both.append(r)
+    r = np.concatenate(both)
+    out["mean"] = float(r.mean())
+    out["max"] = float(r.max())
+    return out
+
+
+def row_alignment(maps: Maps, calib: StereoCalibration, points_left: np.ndarray,
+                  points_right: np.ndarray) -> np.ndarray:
+    """Vertical disparity ``y_left - y_right`` (rectified pixels) of corresponding camera points.
+
+    ``points_left``/``points_right``: (N, 2) distorted pixel positions of the same scene points in
+    both cameras; rectified with ``calib``'s lens models and ``maps``' frame. Zero for a perfect
+    rectification.
+    """
+    if maps.K is None or maps.R1 is None or maps.R2 is None:
+        raise ValueError("row_alignment needs maps that carry K, R1 and R2")
+    pl = rectify_points(points_left, calib.M1, calib.D1, maps.R1, maps.K)
+    pr = rectify_points(points_right, calib.M2, calib.D2, maps.R2, maps.K)
+    return pl[:, 1] - pr[:, 1]
 
 
 def ground_truth_maps(rig: StereoRig, *, size: tuple[int, int] | None = None) -> Maps:

@@ -3,7 +3,7 @@
 The EyeBot M6 (thesis 3.1) carries two 352x288 cameras, focal length 4.9 mm at 9 um pixels
 (f = 4.9 / 0.009 = 544.4 px), 66 mm apart. :func:`eyebot_rig` builds such a rig with lens distortion
 (barrel, k1 about -0.3, plus a little tangential distortion) and a small misalignment: the right
-camera is turned by about 1.3 degrees relative to the left one, the baseline is slightly off the x axis
+camera is turned by about 1.4 degrees relative to the left one, the baseline is slightly off the x axis
 and both principal points are several pixels off the image centre. Its exact backward maps
 (:func:`eyestereo.tools.rectify.ground_truth_maps`) move pixels by up to about 25 px, like the
 "none" row of the thesis's Table 4.1 (docs/toolbox.md gives the figure).
@@ -20,7 +20,7 @@ ground truth.
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
@@ -96,7 +96,6 @@ class RenderedViews:
     corners_right: list[np.ndarray]
     board: tuple[int, int] = BOARD
     square: float = SQUARE
-    extra: dict = field(default_factory=dict, repr=False)
 
 
 def _right_pose(rig: StereoRig, rvec: np.ndarray, tvec: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -215,12 +214,15 @@ def write_rig(folder: str | os.PathLike[str], rig: StereoRig | None = None, n: i
               progress: bool | None = None) -> list[Path]:
     """Write ``left01.png``.. / ``right01.png``.. and the rig's true calibration ``rig_calib.yml``.
 
-    Returns the written paths. Each file is written atomically.
+    ``folder`` is created (not its parents) after the views are rendered. Returns the written paths.
+    Each file is written atomically.
     """
     rig = eyebot_rig() if rig is None else rig
     folder = Path(folder)
-    if not folder.is_dir():
-        raise ValueError(f"output folder {folder} does not exist")
+    if folder.exists() and not folder.is_dir():
+        raise ValueError(f"{folder} exists and is not a folder")
+    if not folder.parent.is_dir():
+        raise ValueError(f"cannot create {folder}: folder {folder.parent} does not exist")
     views = render_views(rig, n, seed=seed, progress=progress)
     encoded = []
     for i, (a, b) in enumerate(zip(views.left, views.right), start=1):
@@ -229,6 +231,7 @@ def write_rig(folder: str | os.PathLike[str], rig: StereoRig | None = None, n: i
             if not ok:
                 raise ValueError(f"cannot encode {name}")
             encoded.append((folder / name, buf.tobytes()))
+    folder.mkdir(exist_ok=True)  # only now that everything is rendered
     written = []
     for path, data in encoded:
         atomic_write_bytes(path, data)
