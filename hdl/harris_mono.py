@@ -47,15 +47,13 @@ def harris_mono(clk, rst, sink, source, k, thr_we, thr_addr, thr_data, *, width:
         blocks: (BX, BY) threshold blocks, default (4, 4): 88x72-pixel blocks at 352x288.
         nms: 1, 3 or 5: non-maximum suppression window.
 
-    Latency: :func:`latency` -- nms 3: 3 lines + 3 pixels + 25 clocks; nms 5: 4 lines + 4 pixels +
+    Latency: :func:`latency` -- nms 3: 4 lines + 4 pixels + 25 clocks; nms 5: 5 lines + 5 pixels +
     27 clocks; nms 1: 3 lines + 3 pixels + 21 clocks.
 
     Resources: 6 (nms 1) to 10 (nms 5) RAMB16, 7 multipliers (3 window, 4 cornerness); see docs/benchmarks.md.
     """
     check_geometry(width, height, min_size=5)
-    if (not isinstance(blocks, (tuple, list)) or len(blocks) != 2):
-        raise ValueError(f"blocks must be a pair of ints (BX, BY), got {blocks!r}")
-    check_params(width, height, tuple(blocks), nms)
+    check_params(width, height, blocks, nms)
     if len(sink.data) != 8:
         raise ValueError(f"harris_mono takes 8-bit pixels, sink has {len(sink.data)} bits")
     if len(source.data) != 1:
@@ -69,6 +67,6 @@ def harris_mono(clk, rst, sink, source, k, thr_we, thr_addr, thr_data, *, width:
         harris_window(clk, rst, s_sobel, s_window, width=width, height=height),
         cornerness(clk, rst, s_window, s_corner, k, width=width, height=height),
         prethreshold(clk, rst, s_corner, s_pre, thr_we, thr_addr, thr_data, width=width, height=height,
-                     blocks=tuple(blocks)),
+                     blocks=blocks),
         nms_block(clk, rst, s_pre, source, width=width, height=height, size=nms),
     ]

@@ -4,7 +4,7 @@ from myhdl import Signal, always, always_comb, always_seq, block, intbv
 
 from eyestereo.hdl.convolve import en_reg
 from eyestereo.hdl.fixed import fx_signal
-from eyestereo.hdl.window import column_taps, delay, window_control
+from eyestereo.hdl.window import assign, column_taps, delay, window_control
 from eyestereo.tools import cornerness as corner_model
 from eyestereo.tools.stream import check_geometry
 
@@ -67,7 +67,7 @@ def nms(clk, rst, sink, source, *, width: int = 352, height: int = 288, size: in
     insts = [column_taps(clk, rst, sink, taps, tap_valid, width=width, height=height)]
     st = [fx_signal(corner_model.OUT) for _ in range(size)]
     for tap, s in zip(taps, st):
-        insts.append(to_signed(tap, s))
+        insts.append(assign(tap, s))  # reinterpret the bits as signed
 
     # Vertical pass (registered): rows above the centre, the centre row, rows below.
     up_c, down_c = fx_signal(corner_model.OUT), fx_signal(corner_model.OUT)
@@ -108,15 +108,6 @@ def nms(clk, rst, sink, source, *, width: int = 352, height: int = 288, size: in
     insts += [outreg, window_control(clk, rst, sink, source, width=width, height=height, radius=r,
                                      latency=size + 2)]
     return insts
-
-
-@block
-def to_signed(word, s):
-    @always_comb
-    def conv():
-        s.next = word
-
-    return conv
 
 
 @block
@@ -176,7 +167,7 @@ def all_of(flags, out):
         nxt = Signal(bool(0))
         insts.append(and2(acc, f, nxt))
         acc = nxt
-    insts.append(follow(acc, out))
+    insts.append(assign(acc, out))
     return insts
 
 
@@ -187,12 +178,3 @@ def and2(a, b, y):
         y.next = a and b
 
     return gate
-
-
-@block
-def follow(a, y):
-    @always_comb
-    def wire():
-        y.next = a
-
-    return wire

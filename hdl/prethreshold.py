@@ -4,7 +4,7 @@ from myhdl import Signal, always, always_comb, always_seq, block, intbv
 
 from eyestereo.hdl.fixed import fx_signal
 from eyestereo.tools import cornerness as corner_model
-from eyestereo.tools.prethreshold import block_edges
+from eyestereo.tools.prethreshold import block_edges, check_blocks
 from eyestereo.tools.stream import check_geometry
 
 
@@ -35,12 +35,8 @@ def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: i
     Resources: BX*BY x 20 bits of LUT-RAM, BX*BY flag registers, position counters, one comparator.
     """
     check_geometry(width, height)
-    if (not isinstance(blocks, (tuple, list)) or len(blocks) != 2
-            or not all(isinstance(v, int) and not isinstance(v, bool) for v in blocks)):
-        raise ValueError(f"blocks must be a pair of ints (BX, BY), got {blocks!r}")
+    check_blocks(width, height, blocks)
     bxn, byn = blocks
-    if not (1 <= bxn <= min(16, width) and 1 <= byn <= min(16, height)):
-        raise ValueError(f"blocks={tuple(blocks)}: BX and BY must be 1..16 and at most the frame's width/height")
     nb = corner_model.OUT.wl
     for name, sig in (("sink", sink.data), ("source", source.data), ("thr_data", thr_data)):
         if len(sig) != nb:
@@ -125,17 +121,7 @@ def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: i
                 if x == xl:
                     bx.next = bx + 1
 
-    @always_seq(clk.posedge, reset=rst)
-    def emit():
-        source.valid.next = sink.valid
-        source.eol.next = sink.eol
-        source.eof.next = sink.eof
-        if value > thr:
-            source.data.next = sink.data
-        else:
-            source.data.next = 0
-
-    return ram, flags, lookup, read, choose, position, emit
+    return ram, flags, lookup, read, choose, position, pass_greater(clk, rst, sink, source, value, thr)
 
 
 @block
@@ -155,6 +141,13 @@ def global_threshold(clk, rst, sink, source, thr_we, thr_data):
         value.next = sink.data
         thr.next = stored
 
+    return register, signed_view, pass_greater(clk, rst, sink, source, value, thr)
+
+
+@block
+def pass_greater(clk, rst, sink, source, value, thr):
+    """The output register: the sink's beat, its data kept where value > thr, else 0."""
+
     @always_seq(clk.posedge, reset=rst)
     def emit():
         source.valid.next = sink.valid
@@ -165,4 +158,4 @@ def global_threshold(clk, rst, sink, source, thr_we, thr_data):
         else:
             source.data.next = 0
 
-    return register, signed_view, emit
+    return emit

@@ -129,6 +129,17 @@ class StreamTB:
         self.sink.check()
 
 
+async def write_thresholds(dut, clk, thresholds: dict[int, int], bits: int) -> None:
+    """Write block thresholds through a ``thr_we/thr_addr/thr_data`` register port, one per clock."""
+    for i, v in thresholds.items():
+        dut.thr_we.value = 1
+        dut.thr_addr.value = int(i)
+        dut.thr_data.value = int(v) & ((1 << bits) - 1)
+        await RisingEdge(clk)
+    dut.thr_we.value = 0
+    await RisingEdge(clk)
+
+
 async def run_scenario(tb: StreamTB, frames: list[np.ndarray], *, token_after: int | None = None,
                        token_frame: np.ndarray | None = None) -> dict:
     """Send (optionally a partial frame and a reset token, then) ``frames`` back to back; check all.

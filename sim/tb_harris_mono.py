@@ -1,9 +1,8 @@
 """cocotb bench: harris_mono against :func:`eyestereo.tools.harris_mono.harris_mono`, bit for bit."""
 
 import cocotb
-from cocotb.triggers import RisingEdge
 
-from eyestereo.sim.bench import StreamTB, run_configured
+from eyestereo.sim.bench import StreamTB, run_configured, write_thresholds
 from eyestereo.tools import cornerness as corner_model
 from eyestereo.tools import harris_mono as model
 
@@ -23,13 +22,7 @@ class HarrisMonoTB(StreamTB):
 
     async def configure(self):
         self.dut.k.value = self.k
-        for i, v in enumerate(self.thresholds):
-            self.dut.thr_we.value = 1
-            self.dut.thr_addr.value = i
-            self.dut.thr_data.value = v & ((1 << corner_model.OUT.wl) - 1)
-            await RisingEdge(self.clk)
-        self.dut.thr_we.value = 0
-        await RisingEdge(self.clk)
+        await write_thresholds(self.dut, self.clk, dict(enumerate(self.thresholds)), corner_model.OUT.wl)
 
     def expected(self, frame):
         return model.harris_mono(frame, self.k, self.thresholds, blocks=self.blocks, nms=self.nms)

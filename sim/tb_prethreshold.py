@@ -7,9 +7,8 @@ follows the writes, after which every threshold must read 0 again.
 
 import cocotb
 import numpy as np
-from cocotb.triggers import RisingEdge
 
-from eyestereo.sim.bench import StreamTB, run_configured
+from eyestereo.sim.bench import StreamTB, run_configured, write_thresholds
 from eyestereo.tools import cornerness as corner_model
 from eyestereo.tools import prethreshold as model
 
@@ -32,13 +31,7 @@ class PrethresholdTB(StreamTB):
         dut.thr_data.value = 0
 
     async def configure(self):
-        for i, v in self.written.items():
-            self.dut.thr_we.value = 1
-            self.dut.thr_addr.value = i
-            self.dut.thr_data.value = v & ((1 << corner_model.OUT.wl) - 1)
-            await RisingEdge(self.clk)
-        self.dut.thr_we.value = 0
-        await RisingEdge(self.clk)
+        await write_thresholds(self.dut, self.clk, self.written, corner_model.OUT.wl)
         if self.cfg.get("reset_after_write"):
             await self.reset()
 

@@ -213,14 +213,16 @@ def test_catalog_default_configuration_elaborates(name):
     inst, ports_, p = spec.elaborate()
     assert inst is not None
     assert p == spec.params()
-    assert set(ports_) == {"clk", "rst", "sink", "source"}
+    assert set(ports_) == {"clk", "rst", "sink", "source"} | {n for n, _ in spec.control}
     assert len(ports_["sink"].data) == spec.sink_width(spec.params())
     assert len(ports_["source"].data) == spec.source_width(spec.params())
 
 
 @pytest.mark.parametrize(
     "name,sink,source",
-    [("line_delay", 8, 8), ("sobel", 8, 18), ("convolve", 8, 8)],  # convolve default: 3x3 binomial / 16
+    [("line_delay", 8, 8), ("sobel", 8, 18), ("convolve", 8, 8),  # convolve default: 3x3 binomial / 16
+     ("harris_window", 18, 57), ("cornerness", 57, 20), ("prethreshold", 20, 20), ("nms", 20, 1),
+     ("harris_mono", 8, 1)],
 )
 def test_catalog_default_widths_hand_computed(name, sink, source):
     spec = BLOCKS[name]

@@ -98,21 +98,34 @@ def test_sobel_full_frame_gaps(request):
 
 
 # --- documented latency and one pixel per clock --------------------------------------------------
-@pytest.mark.parametrize("block,bench,params,radius,latency", [
-    ("line_delay", "tb_line_delay", dict(width=20, height=6, data_width=8), 0, 1),
-    ("convolve", "tb_convolve", dict(width=20, height=8, **KERNELS["sep3"]), 1, 5),
-    ("convolve", "tb_convolve", dict(width=20, height=8, **KERNELS["full5"]), 2, 7),
-    ("sobel", "tb_sobel", dict(width=20, height=8), 1, 5),
-], ids=["line_delay", "convolve3", "convolve5", "sobel"])
-def test_latency_and_throughput(request, block, bench, params, radius, latency):
+@pytest.mark.parametrize("block,bench,params,radius,latency,doc,stim", [
+    ("line_delay", "tb_line_delay", dict(width=20, height=6, data_width=8), 0, 1, "Latency: 1 clock", "random"),
+    ("convolve", "tb_convolve", dict(width=20, height=8, **KERNELS["sep3"]), 1, 5, "Latency: N + 2 clocks", "random"),
+    ("convolve", "tb_convolve", dict(width=20, height=8, **KERNELS["full5"]), 2, 7, "Latency: N + 2 clocks",
+     "random"),
+    ("sobel", "tb_sobel", dict(width=20, height=8), 1, 5, "Latency: 5 clocks", "random"),
+    ("harris_window", "tb_harris_window", dict(width=20, height=8), 2, 8, "Latency: 8 clocks", "grad"),
+    ("cornerness", "tb_cornerness", dict(width=20, height=8), 0, 6, "Latency: 6 clocks", "rwindow"),
+    ("prethreshold", "tb_prethreshold", dict(width=20, height=8, blocks=(4, 4)), 0, 1, "Latency: 1 clock",
+     "rcorner"),
+    ("nms", "tb_nms", dict(width=20, height=8, size=1), 0, 1, "size 1: 1 clock", "rcorner"),
+    ("nms", "tb_nms", dict(width=20, height=8, size=3), 1, 5, "N = 3, 5: N + 2 clocks", "rcorner"),
+    ("nms", "tb_nms", dict(width=20, height=8, size=5), 2, 7, "N = 3, 5: N + 2 clocks", "rcorner"),
+    ("harris_mono", "tb_harris_mono", dict(width=24, height=14, blocks=(2, 2), nms=3), 4, 25,
+     "nms 3: 4 lines + 4 pixels + 25 clocks", "random"),
+    ("harris_mono", "tb_harris_mono", dict(width=24, height=14, blocks=(1, 1), nms=5), 5, 27,
+     "nms 5: 5 lines + 5 pixels +", "random"),
+], ids=["line_delay", "convolve3", "convolve5", "sobel", "harris_window", "cornerness", "prethreshold", "nms1",
+        "nms3", "nms5", "harris_mono3", "harris_mono5"])
+def test_latency_and_throughput(request, block, bench, params, radius, latency, doc, stim):
     """Latency equals the docstring's, and back-to-back frames come out at one pixel per clock."""
     import numpy as np
 
     from eyestereo.hdl.catalog import get
 
-    doc = get(block).func.__doc__
-    assert f"Latency: {latency} clock" in doc or "Latency: N + 2 clocks" in doc
-    rep = _run(block, bench, params, dict(frames=["random:1", "random:2", "random:3"], duty=1.0, timing=True),
+    assert doc in " ".join(get(block).func.__doc__.split())
+    spec = {"random": "random:{}", "grad": "grad:{}:128", "rwindow": "rwindow:{}", "rcorner": "rcorner:{}:-9:9"}[stim]
+    rep = _run(block, bench, params, dict(frames=[spec.format(i) for i in (1, 2, 3)], duty=1.0, timing=True),
                request)
     w, h = params["width"], params["height"]
     n = w * h

@@ -26,8 +26,10 @@ def test_make_vhdl_writes_and_analyses_every_block(tmp_path):
     for b in manifest["blocks"]:
         assert (tmp_path / f"{b['entity']}.vhd").exists()
         names = [p["name"] for p in b["ports"]]
-        assert names[:6] == ["clk", "rst", "sink_data", "sink_valid", "sink_eol", "sink_eof"]
-        assert names[6:] == ["source_data", "source_valid", "source_eol", "source_eof"]
+        control = [n for n, _ in BLOCKS[b["entity"]].control]
+        # MyHDL lists plain signal ports (clk, rst, control) before the flattened stream interfaces.
+        assert names == ["clk", "rst"] + control + ["sink_data", "sink_valid", "sink_eol", "sink_eof",
+                                                     "source_data", "source_valid", "source_eol", "source_eof"]
         dirs = {p["name"]: p["dir"] for p in b["ports"]}
         assert dirs["sink_data"] == "in" and dirs["source_data"] == "out"
         assert b["files"][0] == manifest["package"]

@@ -46,12 +46,7 @@ def radius(nms: int) -> int:
 def check_params(width: int, height: int, blocks: tuple[int, int], nms: int) -> None:
     if nms not in (1, 3, 5):
         raise ValueError(f"nms must be 1, 3 or 5, got {nms!r}")
-    if (not isinstance(blocks, (tuple, list)) or len(blocks) != 2
-            or not all(isinstance(b, int) and not isinstance(b, bool) for b in blocks)):
-        raise ValueError(f"blocks must be a pair of ints (BX, BY), got {blocks!r}")
-    bx, by = blocks
-    if not (1 <= bx <= min(16, width) and 1 <= by <= min(16, height)):
-        raise ValueError(f"blocks={blocks}: each of BX, BY must be 1..16 and at most the frame size")
+    _pre.check_blocks(width, height, blocks)
 
 
 def harris_stages(frame: np.ndarray, k: int, thresholds, *, blocks=(4, 4), nms: int = 3) -> dict:

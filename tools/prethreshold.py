@@ -5,6 +5,16 @@ from __future__ import annotations
 import numpy as np
 
 
+def check_blocks(width: int, height: int, blocks) -> None:
+    """ValueError unless blocks is a pair (BX, BY) of ints, each 1..16 and at most the frame size."""
+    if (not isinstance(blocks, (tuple, list)) or len(blocks) != 2
+            or not all(isinstance(b, int) and not isinstance(b, bool) for b in blocks)):
+        raise ValueError(f"blocks must be a pair of ints (BX, BY), got {blocks!r}")
+    bx, by = blocks
+    if not (1 <= bx <= min(16, width) and 1 <= by <= min(16, height)):
+        raise ValueError(f"blocks={tuple(blocks)}: BX and BY must be 1..16 and at most the frame's width/height")
+
+
 def block_edges(size: int, blocks: int) -> np.ndarray:
     """Start of each block along one axis: block i covers [edges[i], edges[i+1]); edges[i] = i*size//blocks."""
     return np.array([i * size // blocks for i in range(blocks + 1)], dtype=np.int64)
