@@ -91,6 +91,18 @@ def test_rig_command_then_calibrate_its_views(tmp_path, capsys):
     assert np.linalg.norm(est.T - truth.T) < 0.002
 
 
+def test_rig_cover_layout_calibrates_well(tmp_path, capsys):
+    code, out, err = run(capsys, "rig", "-o", tmp_path / "rig", "--views", "9", "--layout", "cover")
+    assert code == 0 and "cover layout" in out, err
+    assert len(files(tmp_path / "rig")) == 19
+    code, out, err = run(capsys, "calibrate", tmp_path / "rig" / "left*.png", tmp_path / "rig" / "right*.png",
+                         "--square", "0.02", "-o", tmp_path / "est.yml")
+    assert code == 0, err
+    est, truth = C.read_yaml(tmp_path / "est.yml"), G.eyebot_rig()
+    assert est.rms < 0.1 and np.linalg.norm(est.T - truth.T) < 0.002
+    assert np.allclose(np.diag(est.M2)[:2], np.diag(truth.M2)[:2], rtol=0.005)
+
+
 # --------------------------------------------------------------------------------------------------
 # Bad input: one line on stderr, exit status 2 (command line) or 1 (run time), nothing written
 
@@ -167,6 +179,16 @@ BAD = {
     "bad views": (["rig", "--views", "0", "-o", "{d}/out"], 2, "must be 1..99"),
     "rig onto a file": (["rig", "-o", "{d}/calib.yml"], 1, "not a folder"),
     "rig parent missing": (["rig", "-o", "{d}/a/b"], 1, "does not exist"),
+    "rig bad layout": (["rig", "--layout", "grid", "-o", "{d}/out"], 2, "invalid choice"),
+    "rectifier missing calib": (["rectifier", "{d}/none.yml", "-o", "{d}/out"], 1, "does not exist"),
+    "rectifier corrupt calib": (["rectifier", "{d}/corrupt.yml", "-o", "{d}/out"], 1, "corrupt.yml"),
+    "rectifier calib without key": (["rectifier", "{d}/nokey.yml", "-o", "{d}/out"], 1, "key 'rms' is missing"),
+    "rectifier onto a file": (["rectifier", "{d}/calib.yml", "-o", "{d}/calib.yml"], 1, "not a folder"),
+    "rectifier onto a used folder": (["rectifier", "{d}/calib.yml", "-o", "{d}"], 1, "did not write"),
+    "rectifier bad degree": (["rectifier", "{d}/calib.yml", "--degree", "1", "-o", "{d}/out"], 2, "invalid choice"),
+    "rectifier bad high": (["rectifier", "{d}/calib.yml", "--high", "x", "-o", "{d}/out"], 2, "not an integer"),
+    "rectifier bad measure": (["rectifier", "{d}/calib.yml", "--measure", "rms", "-o", "{d}/out"], 2,
+                              "invalid choice"),
 }
 
 
@@ -184,9 +206,11 @@ def test_bad_input_gives_one_line_and_no_output(inputs, capsys, case):
 
 def test_help_exits_zero(capsys):
     code, out, _ = run(capsys, "--help")
-    assert code == 0 and "calibrate" in out and "warp" in out
+    assert code == 0 and "calibrate" in out and "warp" in out and "rectifier" in out
     code, out, _ = run(capsys, "maps", "--help")
     assert code == 0 and "--method" in out
+    code, out, _ = run(capsys, "rectifier", "--help")
+    assert code == 0 and "--max-error" in out and "OUTDIR" in out
 
 
 def test_console_script_reports_errors_in_one_line(tmp_path):

@@ -7,7 +7,8 @@
     eyestereo fit maps.npz -o poly.json [--degree 3] [--plots DIR]
     eyestereo warp IMAGE maps.npz|poly.json --side left|right -o OUT.png
     eyestereo lut maps.npz -o lut.h [--frac-bits 5]
-    eyestereo rig -o DIR [--views 10] [--seed 0]
+    eyestereo rig -o DIR [--views 10] [--seed 0] [--layout random|cover]
+    eyestereo rectifier calib.yml -o OUTDIR [--degree 3] [--max-error 0.01] [--size WxH] ...
 
 Every failure ends with one line ``eyestereo: error: ...`` on stderr and exit status 2 (bad command
 line) or 1 (anything found at run time: missing or corrupt files, no chessboard, wrong sizes); outputs
@@ -192,10 +193,40 @@ def _cmd_rig(args: argparse.Namespace) -> int:
     from eyestereo.tools.rig import write_rig
 
     out = Path(args.output)
-    written = write_rig(out, n=args.views, seed=args.seed)
-    print(f"{args.views} synthetic stereo views and the true calibration rig_calib.yml -> {out}/ "
-          f"({len(written)} files)")
+    written = write_rig(out, n=args.views, seed=args.seed, layout=args.layout)
+    print(f"{args.views} synthetic stereo views ({args.layout} layout) and the true calibration "
+          f"rig_calib.yml -> {out}/ ({len(written)} files)")
     return 0
+
+
+def _cmd_rectifier(args: argparse.Namespace) -> int:
+    from eyestereo.tools.rectifier import run_all
+
+    res = run_all(args.calib, args.output, degree=args.degree, max_error=args.max_error, measure=args.measure,
+                  size=args.size, method=args.method, focal=args.focal, low=args.low, high=args.high)
+    ffc = res["ffc"]
+    print(f"rectified {res['width']}x{res['height']}, degree {res['degree']}: mean residual "
+          f"{res['table']['fit']['both']['mean']['r']:.4f} px, max {res['table']['fit']['both']['max']['r']:.4f} px")
+    if ffc is None:
+        _err(f"note: no FFC and no VHDL package: they need degree 3 (this run: degree {res['degree']})")
+    else:
+        errs = ", ".join(f"{n} {e:.3g}" for n, e in ffc.merged_errors.items())
+        print(f"fixed point: {ffc.total_bits} bits in 26 quantizers; {ffc.measure.name} ({ffc.measure.unit}) "
+              f"{errs} <= {ffc.max_error:g}")
+        for w in ffc.wide_inputs:
+            print(f"note: {w} (costs a second MULT18X18)")
+    print(f"{len(res['files'])} files in {res['timings']['total']:.1f} s -> {res['outdir']}/ (see report.txt)")
+    return 0
+
+
+def _nonneg(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+    if not 0 <= v <= 62:
+        raise argparse.ArgumentTypeError(f"must be 0..62, got {v}")
+    return v
 
 
 # --------------------------------------------------------------------------------------------------
@@ -253,8 +284,33 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("rig", help="synthetic EyeBot-like rig: rendered chessboard pairs + true calibration")
     p.add_argument("--views", type=_count, default=10, help="number of stereo views (default 10)")
     p.add_argument("--seed", type=int, default=0, help="random seed of the board poses (default 0)")
+    p.add_argument("--layout", choices=("random", "cover"), default="random",
+                   help="board poses: random, near the image centre (default), or cover, spread over the "
+                        "whole field of view (use about 27 views)")
     p.add_argument("-o", "--output", required=True, help="folder to write into (created if missing; its parent must exist)")
     p.set_defaults(func=_cmd_rig)
+
+    p = sub.add_parser("rectifier", help="the whole toolbox: calib.yml -> maps, polynomials, plots, "
+                       "quantizers, VHDL package and report in one folder",
+                       description="The thesis's run_all: calib.yml -> OUTDIR/maps.npz, poly.json, plots/, "
+                       "quantizers.json, stereo_calibration_pkg.vhd, report.txt. OUTDIR is written only "
+                       "when every step succeeded (it must be new, empty, or an earlier run's output).")
+    p.add_argument("calib", metavar="CALIB", help="calibration file (.yml)")
+    p.add_argument("--degree", type=int, choices=(2, 3, 4), default=3,
+                   help="polynomial degree (default 3; the FFC and the VHDL package need 3)")
+    p.add_argument("--max-error", type=_positive, default=0.01,
+                   help="FFC error bound per polynomial (mse: px^2, max: px; default 0.01)")
+    p.add_argument("--measure", choices=("mse", "max"), default="mse",
+                   help="mse: mean square difference fixed vs float; max: largest absolute difference")
+    p.add_argument("--size", type=_size, default=None,
+                   help="rectified image size WxH (default: the calibrated size)")
+    p.add_argument("--method", choices=("thesis", "opencv"), default="thesis", help="maps construction (default thesis)")
+    p.add_argument("--focal", choices=("mean", "min"), default="mean", help="common focal length (default mean)")
+    p.add_argument("--low", type=_nonneg, default=0, help="FFC: lowest common extra precision L (default 0)")
+    p.add_argument("--high", type=_nonneg, default=32, help="FFC: highest common extra precision H (default 32)")
+    p.add_argument("-o", "--output", required=True, metavar="OUTDIR",
+                   help="output folder (its parent must exist)")
+    p.set_defaults(func=_cmd_rectifier)
 
     try:  # part B: the float-to-fixed conversion, when present
         from eyestereo.tools import cli_ffc

@@ -67,6 +67,7 @@ __all__ = [
     "MAP_KEYS",
     "Maps",
     "backward_map",
+    "BUDGET_GROUPS",
     "compare_up_to_frame",
     "compute_maps",
     "distort",
@@ -76,6 +77,7 @@ __all__ = [
     "maps_for_frame",
     "rectified_camera",
     "rectify_points",
+    "recovery_budget",
     "rectify_rotations",
     "row_alignment",
     "save_maps",
@@ -405,6 +407,71 @@ def compare_up_to_frame(maps: Maps, truth: StereoCalibration, mask: dict[str, np
     r = np.concatenate(both)
     out["mean"] = float(r.mean())
     out["max"] = float(r.max())
+    return out
+
+
+#: Parameter groups of :func:`recovery_budget`: name -> what of the estimate is put into the truth.
+BUDGET_GROUPS = ("principal points", "focal lengths", "distortion", "rotation R", "baseline direction")
+
+
+def _with_group(truth: StereoCalibration, est: StereoCalibration, group: str) -> StereoCalibration:
+    """``truth`` with the parameters of ``group`` taken from ``est``."""
+    M1, M2, D1, D2, R, T = truth.M1.copy(), truth.M2.copy(), truth.D1, truth.D2, truth.R, truth.T
+    if group == "principal points":
+        M1[:2, 2], M2[:2, 2] = est.M1[:2, 2], est.M2[:2, 2]
+    elif group == "focal lengths":
+        M1[0, :2], M1[1, 1], M2[0, :2], M2[1, 1] = est.M1[0, :2], est.M1[1, 1], est.M2[0, :2], est.M2[1, 1]
+    elif group == "distortion":
+        D1, D2 = est.D1, est.D2
+    elif group == "rotation R":
+        R = est.R
+    elif group == "baseline direction":
+        T = est.T * (np.linalg.norm(truth.T) / np.linalg.norm(est.T))
+    else:
+        raise ValueError(f"unknown parameter group {group!r}")
+    return StereoCalibration(M1, D1, M2, D2, R, T, truth.image_width, truth.image_height, 0.0)
+
+
+def recovery_budget(est: StereoCalibration, truth: StereoCalibration,
+                    mask: dict[str, np.ndarray] | None = None,
+                    size: tuple[int, int] | None = None) -> dict[str, Any]:
+    """How far the maps of an estimated calibration are from the true maps, and why.
+
+    Over the rectified pixels of ``mask`` (per side; default all), in pixels:
+
+    * ``raw_mean``, ``raw_max``: the plain distance between the two maps' source points;
+    * ``shift``: per side, the mean vector ``estimate - truth``, and ``after_shift_mean``: the mean
+      distance left once each side's own mean vector is removed. A shift that is the same on both
+      sides is a translation of both rectified images (a different principal point of the common
+      rectified camera): harmless for stereo, since rows and disparities stay as they are;
+    * ``up_to_frame_mean``: :func:`compare_up_to_frame` (what no change of frame explains);
+    * ``only``: for each of :data:`BUDGET_GROUPS`, the raw mean of the maps of the *true*
+      calibration with just that group of parameters taken from ``est`` (one at a time; the
+      estimation errors are correlated and partly cancel, so these do not add up to ``raw_mean``);
+    * ``K_shift``: ``est``'s rectified principal point minus the true one, and ``K_shift_lens``: how
+      much of it goes away when the principal point of ``est``'s frame is placed with the *true*
+      lens models at the image corners (the corners are where a stereo calibration extrapolates).
+    """
+    size = truth.image_size if size is None else size
+    a, b = compute_maps(truth, size=size), compute_maps(est, size=size)
+    raw = map_difference(a, b, mask)
+    out: dict[str, Any] = {"raw_mean": raw["mean"], "raw_max": raw["max"], "shift": {}}
+    resid = []
+    for side in ("left", "right"):
+        (ax, ay), (bx, by) = a.side(side), b.side(side)
+        m = np.ones(ax.shape, bool) if mask is None else np.asarray(mask[side], dtype=bool)
+        dx, dy = (bx - ax)[m], (by - ay)[m]
+        out["shift"][side] = (float(dx.mean()), float(dy.mean()))
+        resid.append(np.hypot(dx - dx.mean(), dy - dy.mean()))
+    out["after_shift_mean"] = float(np.concatenate(resid).mean())
+    out["up_to_frame_mean"] = compare_up_to_frame(b, truth, mask)["mean"]
+    out["only"] = {g: map_difference(a, compute_maps(_with_group(truth, est, g), size=size), mask)["mean"]
+                   for g in BUDGET_GROUPS}
+    lens = StereoCalibration(est.M1, truth.D1, est.M2, truth.D2, est.R, est.T, est.image_width,
+                             est.image_height, 0.0)
+    k_lens = rectified_camera(lens, b.R1, b.R2, size)
+    out["K_shift"] = tuple(float(v) for v in b.K[:2, 2] - a.K[:2, 2])
+    out["K_shift_lens"] = tuple(float(v) for v in b.K[:2, 2] - k_lens[:2, 2])
     return out
 
 

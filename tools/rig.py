@@ -14,7 +14,9 @@ in both cameras: every square and the white paper around the board are polygons 
 and filled at ``supersample`` times the resolution, then area-averaged down, blurred a little
 (Gaussian, sigma 0.6 px) and given mild noise (sigma 1.5 grey levels). The result is a list of grey
 uint8 image pairs plus the true corner positions, so calibration and maps can be checked against
-ground truth.
+ground truth. ``layout="cover"`` spreads the boards over the whole field of view of both cameras
+(corners, edges, several depths and tilts) instead of the middle of the image; :func:`coverage_masks`
+gives the rectified pixels whose source some board covered.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -31,9 +34,12 @@ from eyestereo.tools.progress import Progress
 
 __all__ = [
     "BOARD",
+    "COVER_TARGETS",
+    "LAYOUTS",
     "SQUARE",
     "RenderedViews",
     "StereoRig",
+    "coverage_masks",
     "eyebot_rig",
     "render_views",
     "write_rig",
@@ -115,6 +121,24 @@ def _paper_outline(board: tuple[int, int], square: float, margin: float) -> np.n
     return np.array([[x0, y0, 0], [x1, y0, 0], [x1, y1, 0], [x0, y1, 0]], dtype=np.float64)
 
 
+def _pose_ok(rig: StereoRig, rvec: np.ndarray, tvec: np.ndarray, outline: np.ndarray,
+             margin_px: float) -> bool:
+    """Whether the paper ``outline`` lies wholly inside both images, ``margin_px`` from the border."""
+    w, h = rig.width, rig.height
+    for (rv, tv), M, D in (((rvec, tvec), rig.M1, rig.D1), (_right_pose(rig, rvec, tvec), rig.M2, rig.D2)):
+        pts = _project(outline, rv, tv, M, D)
+        if (pts[:, 0].min() < margin_px or pts[:, 1].min() < margin_px or pts[:, 0].max() > w - 1 - margin_px
+                or pts[:, 1].max() > h - 1 - margin_px):
+            return False
+    return True
+
+
+def _board_rotation(rng: np.random.Generator, tilt: float, spin: float) -> np.ndarray:
+    t = rng.uniform(-tilt, tilt, size=2)  # about x and y
+    s = rng.uniform(-spin, spin)  # in-plane
+    return cv2.Rodrigues(np.array([t[0], t[1], 0.0]))[0] @ cv2.Rodrigues(np.array([0.0, 0.0, s]))[0]
+
+
 def _sample_poses(rig: StereoRig, n: int, rng: np.random.Generator, board: tuple[int, int], square: float,
                   margin_px: float = 6.0) -> list[tuple[np.ndarray, np.ndarray]]:
     cols, rows = board
@@ -127,30 +151,81 @@ def _sample_poses(rig: StereoRig, n: int, rng: np.random.Generator, board: tuple
         tries += 1
         if tries > 20000:
             raise RuntimeError("cannot place the board in view of both cameras")
-        tilt = rng.uniform(-0.55, 0.55, size=2)  # about x and y, up to ~31 degrees
-        spin = rng.uniform(-0.35, 0.35)  # in-plane, up to ~20 degrees
-        rb = cv2.Rodrigues(np.array([tilt[0], tilt[1], 0.0]))[0] @ cv2.Rodrigues(np.array([0.0, 0.0, spin]))[0]
+        rb = _board_rotation(rng, 0.55, 0.35)  # tilted up to ~31 degrees, turned up to ~20 degrees
         z = rng.uniform(0.32, 0.55)
         # aim the board centre at a random pixel of the left image
         px = np.array([rng.uniform(0.2, 0.8) * w, rng.uniform(0.2, 0.8) * h])
         ray = np.linalg.inv(rig.M1) @ np.array([px[0], px[1], 1.0])
         tvec = z * ray - rb @ centre
         rvec = cv2.Rodrigues(rb)[0].ravel()
-        ok = True
-        for (rv, tv), M, D in (((rvec, tvec), rig.M1, rig.D1), (_right_pose(rig, rvec, tvec), rig.M2, rig.D2)):
-            pts = _project(outline, rv, tv, M, D)
-            if (pts[:, 0].min() < margin_px or pts[:, 1].min() < margin_px or pts[:, 0].max() > w - 1 - margin_px
-                    or pts[:, 1].max() > h - 1 - margin_px):
-                ok = False
-                break
-        if ok:
+        if _pose_ok(rig, rvec, tvec, outline, margin_px):
             poses.append((rvec, tvec))
+    return poses
+
+
+#: Targets of the "cover" layout, in this order: (camera 0 = left / 1 = right, x, y as fractions of
+#: the image). Each view's board must cover its target point (the convex hull of its inner corners
+#: contains it). A stereo pair cannot cover the left camera's left edge or the right camera's right
+#: edge (the other camera does not see that far), so the corners are targeted in the camera that can
+#: reach them: the left camera's right-hand corners, the right camera's left-hand ones.
+COVER_TARGETS = ((0, 0.85, 0.15), (1, 0.15, 0.85), (0, 0.85, 0.85), (1, 0.15, 0.15), (0, 0.5, 0.5),
+                 (0, 0.5, 0.15), (1, 0.5, 0.85), (0, 0.85, 0.5), (1, 0.15, 0.5))
+LAYOUTS = ("random", "cover")
+COVER_FAR = 1.0  # farthest board of the "cover" layout, metres (the nearest: 0.32)
+COVER_MIN_SPACING = 11.0  # closer corners (px) are redrawn: findChessboardCorners gets unreliable
+COVER_PAPER = 0.75  # white paper around the squares, in squares (0.5 for "random"; thinner misleads
+#                     findChessboardCorners at an outer corner of far boards now and then)
+
+
+def _sample_cover_poses(rig: StereoRig, n: int, rng: np.random.Generator, board: tuple[int, int],
+                        square: float, margin_px: float = 6.0, paper: float | None = None
+                        ) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Poses that spread over the whole field of view: view ``i`` covers ``COVER_TARGETS[i % 9]``
+    (corners, edge midpoints, centre), at 0.32..1.0 m, tilted by up to 34 degrees about x and y and
+    turned by up to 20 degrees in the image plane; the paper wholly visible in both cameras; corners
+    at least ``COVER_MIN_SPACING`` px apart."""
+    cols, rows = board
+    centre = np.array([(cols - 1) / 2 * square, (rows - 1) / 2 * square, 0.0])
+    outline = _paper_outline(board, square, (COVER_PAPER if paper is None else paper) * square)
+    obj = board_object_points(board, square).astype(np.float64)
+    w, h = rig.width, rig.height
+    poses: list[tuple[np.ndarray, np.ndarray]] = []
+    tries = 0
+    while len(poses) < n:
+        tries += 1
+        if tries > 200000:
+            raise RuntimeError("cannot place the board to cover the field of view of both cameras")
+        cam, fx, fy = COVER_TARGETS[len(poses) % len(COVER_TARGETS)]
+        target = (fx * (w - 1), fy * (h - 1))
+        rb = _board_rotation(rng, 0.6, 0.35)
+        z = rng.uniform(0.32, COVER_FAR)
+        half = 0.5 * cols * square * rig.M1[0, 0] / z  # half the board's width in pixels
+        px = np.array([fx * w, fy * h]) + rng.uniform(-half, half, size=2)
+        M = rig.M1 if cam == 0 else rig.M2
+        ray = np.linalg.inv(M) @ np.array([px[0], px[1], 1.0])
+        tvec = z * ray - rb @ centre
+        if cam == 1:  # placed in the right camera's frame: X_left = R^T (X_right - T)
+            rb, tvec = rig.R.T @ rb, rig.R.T @ (tvec - rig.T)
+        rvec = cv2.Rodrigues(rb)[0].ravel()
+        if not _pose_ok(rig, rvec, tvec, outline, margin_px):
+            continue
+        rv, tv = (rvec, tvec) if cam == 0 else _right_pose(rig, rvec, tvec)
+        pts = _project(obj, rv, tv, M, rig.D1 if cam == 0 else rig.D2)
+        hull = cv2.convexHull(pts.astype(np.float32))
+        if cv2.pointPolygonTest(hull, (float(target[0]), float(target[1])), False) < 0:
+            continue
+        grid = pts.reshape(rows, cols, 2)
+        spacing = min(np.linalg.norm(np.diff(grid, axis=0), axis=2).min(),
+                      np.linalg.norm(np.diff(grid, axis=1), axis=2).min())
+        if spacing < COVER_MIN_SPACING:  # too small to be found reliably
+            continue
+        poses.append((rvec, tvec))
     return poses
 
 
 def _render(rig_side: tuple[np.ndarray, np.ndarray], rvec: np.ndarray, tvec: np.ndarray, size: tuple[int, int],
             board: tuple[int, int], square: float, supersample: int, rng: np.random.Generator,
-            blur: float, noise: float) -> np.ndarray:
+            blur: float, noise: float, paper: float = 0.5) -> np.ndarray:
     M, D = rig_side
     w, h = size
     s = supersample
@@ -167,7 +242,7 @@ def _render(rig_side: tuple[np.ndarray, np.ndarray], rvec: np.ndarray, tvec: np.
         p = (p + 0.5) * s - 0.5
         return np.round(p * (1 << shift)).astype(np.int32).reshape(-1, 1, 2)
 
-    cv2.fillPoly(hi, [polygon(_paper_outline(board, square, 0.5 * square))], 215, cv2.LINE_8, shift)
+    cv2.fillPoly(hi, [polygon(_paper_outline(board, square, paper * square))], 215, cv2.LINE_8, shift)
     black = []
     for j in range(-1, rows):
         for i in range(-1, cols):
@@ -187,23 +262,35 @@ def _render(rig_side: tuple[np.ndarray, np.ndarray], rvec: np.ndarray, tvec: np.
 
 def render_views(rig: StereoRig | None = None, n: int = 10, *, seed: int = 0, board: tuple[int, int] = BOARD,
                  square: float = SQUARE, supersample: int = 8, blur: float = 0.6, noise: float = 1.5,
-                 progress: bool | None = None) -> RenderedViews:
-    """Render ``n`` stereo views of a chessboard at random poses (reproducible from ``seed``)."""
+                 layout: str = "random", progress: bool | None = None) -> RenderedViews:
+    """Render ``n`` stereo views of a chessboard (reproducible from ``seed``).
+
+    ``layout="random"`` (default): poses 0.32..0.55 m away with the board centre aimed at the middle
+    60 % of the left image, paper margin 0.5 squares. ``layout="cover"``: poses spread over the whole
+    field of view of both cameras, corners included, at 0.32..1.0 m, paper margin 0.75 squares (see
+    :data:`COVER_TARGETS`); about 27 views cover the reachable field.
+    """
     rig = eyebot_rig() if rig is None else rig
     if n < 1:
         raise ValueError(f"n must be >= 1, got {n}")
     if supersample < 1:
         raise ValueError(f"supersample must be >= 1, got {supersample}")
+    if layout not in LAYOUTS:
+        raise ValueError(f"layout must be 'random' or 'cover', got {layout!r}")
     rng = np.random.default_rng(seed)
-    poses = _sample_poses(rig, n, rng, board, square)
+    sampler = _sample_poses if layout == "random" else _sample_cover_poses
+    poses = sampler(rig, n, rng, board, square)
+    paper = 0.5 if layout == "random" else COVER_PAPER
     obj = board_object_points(board, square).astype(np.float64)
     out = RenderedViews([], [], poses, [], [], tuple(board), float(square))
     size = (rig.width, rig.height)
     with Progress(n, "rendering views", force=progress) as bar:
         for rvec, tvec in poses:
             rv2, tv2 = _right_pose(rig, rvec, tvec)
-            out.left.append(_render((rig.M1, rig.D1), rvec, tvec, size, board, square, supersample, rng, blur, noise))
-            out.right.append(_render((rig.M2, rig.D2), rv2, tv2, size, board, square, supersample, rng, blur, noise))
+            out.left.append(_render((rig.M1, rig.D1), rvec, tvec, size, board, square, supersample, rng, blur, noise,
+                                     paper))
+            out.right.append(_render((rig.M2, rig.D2), rv2, tv2, size, board, square, supersample, rng, blur, noise,
+                                      paper))
             out.corners_left.append(_project(obj, rvec, tvec, rig.M1, rig.D1))
             out.corners_right.append(_project(obj, rv2, tv2, rig.M2, rig.D2))
             bar.update()
@@ -211,7 +298,7 @@ def render_views(rig: StereoRig | None = None, n: int = 10, *, seed: int = 0, bo
 
 
 def write_rig(folder: str | os.PathLike[str], rig: StereoRig | None = None, n: int = 10, *, seed: int = 0,
-              progress: bool | None = None) -> list[Path]:
+              layout: str = "random", progress: bool | None = None) -> list[Path]:
     """Write ``left01.png``.. / ``right01.png``.. and the rig's true calibration ``rig_calib.yml``.
 
     ``folder`` is created (not its parents) after the views are rendered. Returns the written paths.
@@ -223,7 +310,7 @@ def write_rig(folder: str | os.PathLike[str], rig: StereoRig | None = None, n: i
         raise ValueError(f"{folder} exists and is not a folder")
     if not folder.parent.is_dir():
         raise ValueError(f"cannot create {folder}: folder {folder.parent} does not exist")
-    views = render_views(rig, n, seed=seed, progress=progress)
+    views = render_views(rig, n, seed=seed, layout=layout, progress=progress)
     encoded = []
     for i, (a, b) in enumerate(zip(views.left, views.right), start=1):
         for name, img in ((f"left{i:02d}.png", a), (f"right{i:02d}.png", b)):
@@ -240,3 +327,27 @@ def write_rig(folder: str | os.PathLike[str], rig: StereoRig | None = None, n: i
     write_yaml(rig.calibration(), calib_path)
     written.append(calib_path)
     return written
+
+
+def coverage_masks(views: RenderedViews, maps: Any, size: tuple[int, int] | None = None) -> dict[str, np.ndarray]:
+    """Rectified pixels whose source lies where some rendered board was (per side, boolean (h, w)).
+
+    "Where a board was" is the union over the views of the convex hull of the board's true inner
+    corners in that camera's image; ``maps`` (a :class:`~eyestereo.tools.rectify.Maps`) says where each
+    rectified pixel's source is. ``size``: the camera image size (default: the maps' source size).
+    """
+    size = size or maps.source_size
+    if size is None:
+        raise ValueError("coverage_masks needs the camera image size")
+    w, h = size
+    masks = {}
+    for side, corners in (("left", views.corners_left), ("right", views.corners_right)):
+        src = np.zeros((h, w), np.uint8)
+        for c in corners:
+            cv2.fillConvexPoly(src, cv2.convexHull(np.asarray(c, np.float32)).astype(np.int32), 1)
+        mx, my = maps.side(side)
+        inside = np.isfinite(mx) & np.isfinite(my) & (mx >= 0) & (mx <= w - 1) & (my >= 0) & (my <= h - 1)
+        xi = np.clip(np.round(np.nan_to_num(mx)), 0, w - 1).astype(int)
+        yi = np.clip(np.round(np.nan_to_num(my)), 0, h - 1).astype(int)
+        masks[side] = inside & (src[yi, xi] > 0)
+    return masks
