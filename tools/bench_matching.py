@@ -665,7 +665,8 @@ image and one box sum per disparity, running minimum), and OpenCV's StereoBM 9x9
 uniqueness and speckle filters off (it still pre-filters with a clipped x-Sobel and interpolates to 1/16 px).
 Evaluated over all pixels with an estimate and known ground truth (occluded pixels included; no border
 other than the window's). The thesis ran the Middlebury C++ code on the EyeBot: 5.1 s for SAD 9x9 on
-Tsukuba. Here: {tsukuba_dense} (about {tsukuba_factor} times faster).
+Tsukuba. Here: {tsukuba_dense} (a factor of about {tsukuba_factor}; the CPUs differ too much for that to
+compare the implementations).
 
 {dense}
 

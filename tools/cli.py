@@ -13,7 +13,8 @@
 Every failure ends with one line ``eyestereo: error: ...`` on stderr and exit status 2 (bad command
 line) or 1 (anything found at run time: missing or corrupt files, no chessboard, wrong sizes); outputs
 are written atomically, so a failed command leaves no partial file behind. Subcommands of the
-float-to-fixed conversion are added by ``eyestereo.tools.cli_ffc`` when it is installed.
+float-to-fixed conversion are added by ``eyestereo.tools.cli_ffc``, ``evaluate`` and ``sweep`` by
+``eyestereo.tools.cli_eval``.
 """
 
 from __future__ import annotations
@@ -234,9 +235,10 @@ def _nonneg(text: str) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The full argument parser (part B's subcommands included when available)."""
-    parser = _Parser(prog=PROG, description="Rectification Toolbox: stereo calibration, rectification "
-                     "maps, regression polynomials and image warping (thesis 3, 4 and Appendix A).")
+    """The full argument parser."""
+    parser = _Parser(prog=PROG, description="eyestereo's software side: the rectification toolbox (stereo "
+                     "calibration, maps, regression polynomials, float-to-fixed conversion, VHDL package, "
+                     "warping; thesis 2-4 and Appendix A) and the feature-matching evaluation (thesis 7.3).")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
 
     p = sub.add_parser("calibrate", help="stereo calibration from chessboard image pairs -> calib.yml")
@@ -312,12 +314,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="output folder (its parent must exist)")
     p.set_defaults(func=_cmd_rectifier)
 
-    try:  # part B: the float-to-fixed conversion, when present
-        from eyestereo.tools import cli_ffc
-    except ImportError:
-        cli_ffc = None
-    if cli_ffc is not None:
-        cli_ffc.register(sub)
+    # The float-to-fixed conversion (ffc, package) and the matching study (evaluate, sweep) live in
+    # their own modules.
+    from eyestereo.tools import cli_eval, cli_ffc
+
+    cli_ffc.register(sub)
+    cli_eval.register(sub)
     return parser
 
 
