@@ -19,6 +19,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from .cli import _nonneg, _positive  # shared argument types (cli imports this module only lazily)
 from .ffc import MEASURES, FFCError, read_poly_json, run_ffc, write_quantizers_json
 from .vhdl_package import DEFAULT_NAME, write_package
 
@@ -30,26 +31,6 @@ PROG = "eyestereo"
 def _error(msg: str) -> int:
     print(f"{PROG}: error: {' '.join(str(msg).split())}", file=sys.stderr)
     return 1
-
-
-def _positive_float(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if not v > 0 or v == float("inf"):
-        raise argparse.ArgumentTypeError(f"must be a positive finite number, got {text}")
-    return v
-
-
-def _nonneg_int(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
-    if v < 0:
-        raise argparse.ArgumentTypeError(f"must be >= 0, got {v}")
-    return v
 
 
 def _check_output(path: Path) -> None:
@@ -101,12 +82,12 @@ def register(subparsers: Any) -> None:
                     "ranges, coarse search, greedy tuning, merge of the four polynomials.")
     p.add_argument("poly", type=Path, help="poly.json with the four degree-3 polynomials")
     p.add_argument("-o", "--output", type=Path, required=True, help="quantizers.json to write")
-    p.add_argument("--max-error", type=_positive_float, default=0.01,
+    p.add_argument("--max-error", type=_positive, default=0.01,
                    help="error bound per polynomial (mse: px^2, max: px; default 0.01)")
     p.add_argument("--measure", choices=sorted(MEASURES), default="mse",
                    help="mse: mean square difference; max: maximum absolute difference (default mse)")
-    p.add_argument("--low", type=_nonneg_int, default=0, help="L, lowest common extra precision (default 0)")
-    p.add_argument("--high", type=_nonneg_int, default=32, help="H, highest common extra precision (default 32)")
+    p.add_argument("--low", type=_nonneg, default=0, help="L, lowest common extra precision (default 0)")
+    p.add_argument("--high", type=_nonneg, default=32, help="H, highest common extra precision (default 32)")
     p.set_defaults(func=cmd_ffc)
 
     q = subparsers.add_parser(
