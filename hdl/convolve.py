@@ -3,7 +3,7 @@
 import numpy as np
 from myhdl import Signal, always, always_comb, block, intbv
 
-from eyestereo.hdl.window import _sig, _sig_range, column_taps, delay, shift_add, window_control
+from eyestereo.hdl.window import _sig, _sig_range, column_taps, delay, en_reg, shift_add, window_control
 from eyestereo.hdl.fixed import fx_signal
 from eyestereo.tools.convolve import check_kernel, output_format
 from eyestereo.tools.stream import check_geometry
@@ -108,13 +108,3 @@ def _sum_sig(sigs, coeffs):
         lo += min(a * c, b * c)
         hi += max(a * c, b * c)
     return _sig(lo, hi)
-
-
-@block
-def en_reg(clk, en, d, q):
-    @always(clk.posedge)
-    def reg():
-        if en:
-            q.next = d
-
-    return reg

@@ -2,10 +2,9 @@
 
 from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv
 
-from eyestereo.hdl.convolve import en_reg
 from eyestereo.hdl.fixed import fx_signal
 from eyestereo.hdl.stream import ImageStream
-from eyestereo.hdl.window import _sig, column_taps, delay, shift_add, window_control
+from eyestereo.hdl.window import _sig, column_taps, delay, en_reg, shift_add, window_control
 from eyestereo.tools import harris_window as model
 from eyestereo.tools.fixed import sfix
 from eyestereo.tools.stream import check_geometry

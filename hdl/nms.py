@@ -2,9 +2,8 @@
 
 from myhdl import Signal, always, always_comb, always_seq, block, intbv
 
-from eyestereo.hdl.convolve import en_reg
 from eyestereo.hdl.fixed import fx_signal
-from eyestereo.hdl.window import assign, column_taps, delay, window_control
+from eyestereo.hdl.window import assign, column_taps, delay, en_reg, window_control
 from eyestereo.tools import cornerness as corner_model
 from eyestereo.tools.stream import check_geometry
 

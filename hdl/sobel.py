@@ -2,9 +2,8 @@
 
 from myhdl import Signal, always, block, concat, intbv
 
-from eyestereo.hdl.convolve import en_reg
 from eyestereo.hdl.fixed import fx_signal
-from eyestereo.hdl.window import _sig, column_taps, delay, shift_add, window_control
+from eyestereo.hdl.window import _sig, column_taps, delay, en_reg, shift_add, window_control
 from eyestereo.tools.fixed import shift_between
 from eyestereo.tools.sobel import GRAD, OUT
 from eyestereo.tools.stream import check_geometry

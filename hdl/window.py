@@ -22,7 +22,7 @@ from eyestereo.hdl.line_delay import line_delay
 from eyestereo.hdl.stream import ImageStream
 
 
-def _copy(sig, name_hint=None):
+def _copy(sig):
     return Signal(intbv(0, min=sig.min, max=sig.max)) if sig.min is not None else Signal(intbv(0)[len(sig):])
 
 
@@ -45,6 +45,18 @@ def dreg(clk, d, q):
     @always(clk.posedge)
     def reg():
         q.next = d
+
+    return reg
+
+
+@block
+def en_reg(clk, en, d, q):
+    """q takes d on the clock edges where en is high (a register with enable, no reset)."""
+
+    @always(clk.posedge)
+    def reg():
+        if en:
+            q.next = d
 
     return reg
 

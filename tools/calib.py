@@ -171,57 +171,51 @@ class StereoCalibration:
         return float(np.linalg.norm(self.T))
 
 
-def _as_matrix(a: Any, shape: tuple[int, int], name: str) -> np.ndarray:
+def _numeric(a: Any, name: str, what: str) -> np.ndarray:
+    """``a`` as a float64 array, or a one-line ValueError naming ``name``."""
     try:
-        m = np.array(a, dtype=np.float64)
+        return np.array(a, dtype=np.float64)
     except (TypeError, ValueError):
-        raise ValueError(f"{name} is not a numeric matrix") from None
+        raise ValueError(f"{name} is not a numeric {what}") from None
+
+
+def _finite(x: np.ndarray, name: str) -> np.ndarray:
+    if not np.all(np.isfinite(x)):
+        raise ValueError(f"{name} contains NaN or infinite values")
+    return x
+
+
+def _as_matrix(a: Any, shape: tuple[int, int], name: str) -> np.ndarray:
+    m = _numeric(a, name, "matrix")
     if m.shape != shape:
         raise ValueError(f"{name} must be {shape[0]}x{shape[1]}, got shape {m.shape}")
-    if not np.all(np.isfinite(m)):
-        raise ValueError(f"{name} contains NaN or infinite values")
-    return m
+    return _finite(m, name)
 
 
 def _as_dist(a: Any, name: str) -> np.ndarray:
-    try:
-        d = np.array(a, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} is not a numeric vector") from None
+    d = _numeric(a, name, "vector")
     if d.ndim > 2 or (d.ndim == 2 and 1 not in d.shape):
         raise ValueError(f"{name} must be a vector (1xN or Nx1), got shape {d.shape}")
     d = d.ravel()
     if d.size not in DIST_LENGTHS:
         raise ValueError(f"{name} must have 4, 5, 8, 12 or 14 coefficients, got {d.size}")
-    if not np.all(np.isfinite(d)):
-        raise ValueError(f"{name} contains NaN or infinite values")
-    return d
+    return _finite(d, name)
 
 
 def _as_vector3(a: Any, name: str) -> np.ndarray:
-    try:
-        v = np.array(a, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} is not a numeric vector") from None
+    v = _numeric(a, name, "vector")
     if v.size != 3 or (v.ndim == 2 and 1 not in v.shape) or v.ndim > 2:
         raise ValueError(f"{name} must have 3 elements (3x1 or 1x3), got shape {v.shape}")
-    v = v.ravel()
-    if not np.all(np.isfinite(v)):
-        raise ValueError(f"{name} contains NaN or infinite values")
-    return v
+    return _finite(v.ravel(), name)
 
 
 def _as_rotation(a: Any, name: str) -> np.ndarray:
-    try:
-        r = np.array(a, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} is not a numeric matrix") from None
+    r = _numeric(a, name, "matrix")
     if r.size == 3 and r.ndim <= 2:  # a rotation vector (Rodrigues), as some tools store it
         r = cv2.Rodrigues(_as_vector3(r, name))[0]
     if r.shape != (3, 3):
         raise ValueError(f"{name} must be a 3x3 rotation matrix (or a 3-element rotation vector), got shape {r.shape}")
-    if not np.all(np.isfinite(r)):
-        raise ValueError(f"{name} contains NaN or infinite values")
+    _finite(r, name)
     if np.abs(r @ r.T - np.eye(3)).max() > 1e-6 or np.linalg.det(r) < 0:
         raise ValueError(f"{name} is not a rotation matrix (R R^T != I or det(R) < 0)")
     return r
