@@ -56,9 +56,9 @@ synth: setup
 
 bench: setup
 	$(PY) -m eyestereo.sim.benchmark --out docs/benchmarks.md
-	$(PY) -m eyestereo.tools.harris_report --out docs/harris.md
-	$(PY) -m eyestereo.tools.bench_ffc
-	$(PY) -m eyestereo.tools.bench_matching --out docs/matching.md
+	$(PY) -m eyestereo.tools.reports.harris_report --out docs/harris.md
+	$(PY) -m eyestereo.tools.reports.bench_ffc
+	$(PY) -m eyestereo.tools.reports.bench_matching --out docs/matching.md
 
 clean:
 	rm -rf build .pytest_cache .hypothesis

@@ -21,9 +21,9 @@ from eyestereo.hdl.prethreshold import prethreshold
 from eyestereo.hdl.line_delay import line_delay
 from eyestereo.hdl.sobel import sobel
 from eyestereo.hdl.stream import ImageStream
-from eyestereo.tools import cornerness as corner_model
-from eyestereo.tools import harris_window as window_model
-from eyestereo.tools.convolve import check_kernel, output_width
+from eyestereo.tools.models import cornerness as corner_model
+from eyestereo.tools.models import harris_window as window_model
+from eyestereo.tools.models.convolve import check_kernel, output_width
 
 
 @dataclass(frozen=True)

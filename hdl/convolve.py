@@ -3,9 +3,9 @@
 import numpy as np
 from myhdl import Signal, always, always_comb, block, intbv
 
-from eyestereo.hdl.window import _sig, _sig_range, column_taps, delay, en_reg, shift_add, window_control
-from eyestereo.hdl.fixed import fx_signal
-from eyestereo.tools.convolve import check_kernel, output_format
+from eyestereo.hdl.common import range_signal, signal_range, column_taps, delay, en_reg, shift_add, window_control
+from eyestereo.hdl.common.fixed import fx_signal
+from eyestereo.tools.models.convolve import check_kernel, output_format
 from eyestereo.tools.stream import check_geometry
 
 
@@ -23,7 +23,7 @@ def convolve(clk, rst, sink, source, *, kernel=None, col=None, row=None, shift: 
     Ports:
         clk, rst: clock and synchronous active-high reset (control only).
         sink: ImageStream, unsigned pixels of any width up to 36 bits.
-        source: ImageStream whose data width is :func:`eyestereo.tools.convolve.output_width`
+        source: ImageStream whose data width is :func:`eyestereo.tools.models.convolve.output_width`
             (two's complement when the kernel has negative coefficients).
 
     Parameters:
@@ -58,12 +58,12 @@ def convolve(clk, rst, sink, source, *, kernel=None, col=None, row=None, shift: 
         rv = [int(c) for c in np.asarray(row, dtype=np.int64)]
         vlo = sum(min(c * 0, c * ((1 << dw) - 1)) for c in cv)
         vhi = sum(max(c * 0, c * ((1 << dw) - 1)) for c in cv)
-        vsum = _sig(vlo, vhi)
-        vreg = _sig(vlo, vhi)
+        vsum = range_signal(vlo, vhi)
+        vreg = range_signal(vlo, vhi)
         vvalid = Signal(bool(0))
         insts += [shift_add(list(zip(taps, cv)), vsum), delay(clk, vsum, vreg, clocks=1),
                   delay(clk, tap_valid, vvalid, clocks=1)]
-        hregs = [_sig(vlo, vhi) for _ in range(n)]  # hregs[0] newest = rightmost column
+        hregs = [range_signal(vlo, vhi) for _ in range(n)]  # hregs[0] newest = rightmost column
         src = vreg
         for h in hregs:
             insts.append(en_reg(clk, vvalid, src, h))
@@ -80,7 +80,7 @@ def convolve(clk, rst, sink, source, *, kernel=None, col=None, row=None, shift: 
                 src = reg
             coeffs = [int(c) for c in k[i][::-1]]
             rs = _sum_sig(w, coeffs)
-            rreg = _sig(*_sig_range(rs))
+            rreg = range_signal(*signal_range(rs))
             insts += [shift_add(list(zip(w, coeffs)), rs), delay(clk, rs, rreg, clocks=1)]
             rowsums.append(rreg)
         total = _sum_sig(rowsums, [1] * n)
@@ -104,7 +104,7 @@ def convolve(clk, rst, sink, source, *, kernel=None, col=None, row=None, shift: 
 def _sum_sig(sigs, coeffs):
     lo = hi = 0
     for s, c in zip(sigs, coeffs):
-        a, b = _sig_range(s)
+        a, b = signal_range(s)
         lo += min(a * c, b * c)
         hi += max(a * c, b * c)
-    return _sig(lo, hi)
+    return range_signal(lo, hi)

@@ -2,10 +2,10 @@
 
 from myhdl import Signal, always, always_comb, block, intbv
 
-from eyestereo.hdl.fixed import fx_signal
-from eyestereo.hdl.window import delay_rst
-from eyestereo.tools import cornerness as model
-from eyestereo.tools import harris_window as window_model
+from eyestereo.hdl.common.fixed import fx_signal
+from eyestereo.hdl.common import delay_rst
+from eyestereo.tools.models import cornerness as model
+from eyestereo.tools.models import harris_window as window_model
 from eyestereo.tools.stream import check_geometry
 
 LATENCY = model.LATENCY
@@ -15,7 +15,7 @@ LATENCY = model.LATENCY
 def cornerness(clk, rst, sink, source, k, *, width: int = 352, height: int = 288):
     """Cornerness of every pixel from the window sums; a point operation, 6 pipeline stages.
 
-    Stages (formats in :mod:`eyestereo.tools.cornerness`): the sums are cut to 17 bits (a, b, c, and
+    Stages (formats in :mod:`eyestereo.tools.models.cornerness`): the sums are cut to 17 bits (a, b, c, and
     the half trace t), so each of the 4 multipliers (a*b, c*c, k*t, (k*t >> 8)*t) takes operands that
     fit a MULT18X18's signed 18-bit inputs; det - 4 k t^2 is formed in 37 bits and shifted right by 13
     into the 20-bit output with saturation, which never triggers on the positive side for windows of
@@ -25,8 +25,8 @@ def cornerness(clk, rst, sink, source, k, *, width: int = 352, height: int = 288
         clk, rst: clock and synchronous active-high reset (control only).
         sink: ImageStream, 57 bits from ``harris_window`` (Sxy | Syy | Sxx).
         source: ImageStream, 20 bits: the cornerness, two's complement (units:
-            :func:`eyestereo.tools.harris_mono.harris_float` / 2**21).
-        k: input, 8 bits, ufix[8,8]: k = code / 256 (:func:`eyestereo.tools.harris_mono.k_code`);
+            :func:`eyestereo.tools.models.harris_mono.harris_float` / 2**21).
+        k: input, 8 bits, ufix[8,8]: k = code / 256 (:func:`eyestereo.tools.models.harris_mono.k_code`);
             sampled every clock, change it between frames.
 
     Parameters:

@@ -11,9 +11,9 @@ from eyestereo.hdl.prethreshold import prethreshold
 from eyestereo.hdl.sobel import LATENCY as SOBEL_LATENCY
 from eyestereo.hdl.sobel import sobel
 from eyestereo.hdl.stream import ImageStream
-from eyestereo.tools import cornerness as corner_model
-from eyestereo.tools import harris_window as window_model
-from eyestereo.tools.harris_mono import check_params, k_code, radius, threshold_code  # noqa: F401 (re-export)
+from eyestereo.tools.models import cornerness as corner_model
+from eyestereo.tools.models import harris_window as window_model
+from eyestereo.tools.models.harris_mono import check_params, k_code, radius, threshold_code  # noqa: F401 (re-export)
 from eyestereo.tools.stream import check_geometry
 
 

@@ -2,10 +2,10 @@
 
 from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv
 
-from eyestereo.hdl.fixed import fx_signal
+from eyestereo.hdl.common.fixed import fx_signal
 from eyestereo.hdl.stream import ImageStream
-from eyestereo.hdl.window import _sig, column_taps, delay, en_reg, shift_add, window_control
-from eyestereo.tools import harris_window as model
+from eyestereo.hdl.common import range_signal, column_taps, delay, en_reg, shift_add, window_control
+from eyestereo.tools.models import harris_window as model
 from eyestereo.tools.fixed import sfix
 from eyestereo.tools.stream import check_geometry
 
@@ -46,7 +46,7 @@ def harris_window(clk, rst, sink, source, *, width: int = 352, height: int = 288
     mx = fx_signal(sfix(10))  # 2 Ix + 1
     my = fx_signal(sfix(10))
     big = 511 * 511
-    fxx, fyy, fxy = _sig(0, big + 16), _sig(0, big + 16), _sig(-big + 16, big + 16)
+    fxx, fyy, fxy = range_signal(0, big + 16), range_signal(0, big + 16), range_signal(-big + 16, big + 16)
     qxx, qyy = fx_signal(model.PROD_SQ), fx_signal(model.PROD_SQ)
     qxy = fx_signal(model.PROD_XY)
     sq_top = model.PROD_SQ.hi
@@ -109,9 +109,9 @@ def harris_window(clk, rst, sink, source, *, width: int = 352, height: int = 288
             insts.append(field(tap, f, lo_bit))
         vlo = fmt.lo * sum(weights)
         vhi = fmt.hi * sum(weights)
-        vsum, vreg = _sig(vlo, vhi), _sig(vlo, vhi)
+        vsum, vreg = range_signal(vlo, vhi), range_signal(vlo, vhi)
         insts += [shift_add(list(zip(fields_i, weights)), vsum), delay(clk, vsum, vreg, clocks=1)]
-        row = [_sig(vlo, vhi) for _ in range(N)]
+        row = [range_signal(vlo, vhi) for _ in range(N)]
         src = vreg
         for reg in row:
             insts.append(en_reg(clk, col_valid, src, reg))

@@ -2,9 +2,9 @@
 
 from myhdl import Signal, always, always_comb, always_seq, block, intbv
 
-from eyestereo.hdl.fixed import fx_signal
-from eyestereo.hdl.window import assign, column_taps, delay, en_reg, window_control
-from eyestereo.tools import cornerness as corner_model
+from eyestereo.hdl.common.fixed import fx_signal
+from eyestereo.hdl.common import assign, column_taps, delay, en_reg, window_control
+from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.stream import check_geometry
 
 SIZES = (1, 3, 5)

@@ -2,9 +2,9 @@
 
 from myhdl import Signal, always, always_comb, always_seq, block, intbv
 
-from eyestereo.hdl.fixed import fx_signal
-from eyestereo.tools import cornerness as corner_model
-from eyestereo.tools.prethreshold import block_edges, check_blocks
+from eyestereo.hdl.common.fixed import fx_signal
+from eyestereo.tools.models import cornerness as corner_model
+from eyestereo.tools.models.prethreshold import block_edges, check_blocks
 from eyestereo.tools.stream import check_geometry
 
 

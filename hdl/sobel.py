@@ -2,10 +2,10 @@
 
 from myhdl import Signal, always, block, concat, intbv
 
-from eyestereo.hdl.fixed import fx_signal
-from eyestereo.hdl.window import _sig, column_taps, delay, en_reg, shift_add, window_control
+from eyestereo.hdl.common.fixed import fx_signal
+from eyestereo.hdl.common import range_signal, column_taps, delay, en_reg, shift_add, window_control
 from eyestereo.tools.fixed import shift_between
-from eyestereo.tools.sobel import GRAD, OUT
+from eyestereo.tools.models.sobel import GRAD, OUT
 from eyestereo.tools.stream import check_geometry
 
 LATENCY = 5
@@ -45,8 +45,8 @@ def sobel(clk, rst, sink, source, *, width: int = 352, height: int = 288):
     insts = [column_taps(clk, rst, sink, taps, tap_valid, width=width, height=height)]
 
     # Vertical pass, registered.
-    smooth_c, smooth = _sig(0, 1020), _sig(0, 1020)
-    diff_c, diff = _sig(-255, 255), _sig(-255, 255)
+    smooth_c, smooth = range_signal(0, 1020), range_signal(0, 1020)
+    diff_c, diff = range_signal(-255, 255), range_signal(-255, 255)
     col_valid = Signal(bool(0))
     insts += [shift_add([(top, 1), (mid, 2), (bot, 1)], smooth_c),
               shift_add([(bot, 1), (top, -1)], diff_c),
@@ -54,8 +54,8 @@ def sobel(clk, rst, sink, source, *, width: int = 352, height: int = 288):
               delay(clk, tap_valid, col_valid, clocks=1)]
 
     # A row of three columns; index 0 is the newest (right-hand) one.
-    s = [_sig(0, 1020) for _ in range(3)]
-    d = [_sig(-255, 255) for _ in range(3)]
+    s = [range_signal(0, 1020) for _ in range(3)]
+    d = [range_signal(-255, 255) for _ in range(3)]
     for regs, first in ((s, smooth), (d, diff)):
         src = first
         for reg in regs:

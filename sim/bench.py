@@ -37,7 +37,7 @@ def make_frame(spec: str, width: int, height: int, bits: int = 8) -> np.ndarray:
     codes in [-LIM, LIM)), ``rwindow:SEED`` (window words), ``rcorner:SEED:LO:HI`` (cornerness codes in
     [LO, HI]).
     """
-    from eyestereo.tools import cornerness, harris_window, sobel
+    from eyestereo.tools.models import cornerness, harris_window, sobel
 
     kind, _, arg = spec.partition(":")
     if kind == "random":

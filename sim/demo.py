@@ -19,9 +19,9 @@ import numpy as np
 
 from eyestereo.sim.bench import make_frame
 from eyestereo.sim.runner import ROOT, run_bench
-from eyestereo.tools import harris_mono as hm
-from eyestereo.tools import prethreshold as pt
-from eyestereo.tools import sobel as model
+from eyestereo.tools.models import harris_mono as hm
+from eyestereo.tools.models import prethreshold as pt
+from eyestereo.tools.models import sobel as model
 
 IMAGE = "tsukuba_im3.png"
 WIDTH, HEIGHT = 352, 288

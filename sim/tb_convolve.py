@@ -1,9 +1,9 @@
-"""cocotb bench: convolve against :func:`eyestereo.tools.convolve.convolve`, bit for bit."""
+"""cocotb bench: convolve against :func:`eyestereo.tools.models.convolve.convolve`, bit for bit."""
 
 import cocotb
 
 from eyestereo.sim.bench import StreamTB, run_configured
-from eyestereo.tools import convolve as model
+from eyestereo.tools.models import convolve as model
 
 
 class ConvolveTB(StreamTB):

@@ -1,10 +1,10 @@
-"""cocotb bench: cornerness against :func:`eyestereo.tools.cornerness.cornerness`, bit for bit."""
+"""cocotb bench: cornerness against :func:`eyestereo.tools.models.cornerness.cornerness`, bit for bit."""
 
 import cocotb
 import numpy as np
 
 from eyestereo.sim.bench import StreamTB, run_configured
-from eyestereo.tools import cornerness as model
+from eyestereo.tools.models import cornerness as model
 
 
 class CornernessTB(StreamTB):

@@ -1,10 +1,10 @@
-"""cocotb bench: harris_mono against :func:`eyestereo.tools.harris_mono.harris_mono`, bit for bit."""
+"""cocotb bench: harris_mono against :func:`eyestereo.tools.models.harris_mono.harris_mono`, bit for bit."""
 
 import cocotb
 
 from eyestereo.sim.bench import StreamTB, run_configured, write_thresholds
-from eyestereo.tools import cornerness as corner_model
-from eyestereo.tools import harris_mono as model
+from eyestereo.tools.models import cornerness as corner_model
+from eyestereo.tools.models import harris_mono as model
 
 
 class HarrisMonoTB(StreamTB):

@@ -1,9 +1,9 @@
-"""cocotb bench: harris_window against :func:`eyestereo.tools.harris_window.harris_window`, bit for bit."""
+"""cocotb bench: harris_window against :func:`eyestereo.tools.models.harris_window.harris_window`, bit for bit."""
 
 import cocotb
 
 from eyestereo.sim.bench import StreamTB, run_configured
-from eyestereo.tools import harris_window as model
+from eyestereo.tools.models import harris_window as model
 
 
 class HarrisWindowTB(StreamTB):

@@ -1,9 +1,9 @@
-"""cocotb bench: line_delay against :func:`eyestereo.tools.line_delay.line_delay`, bit for bit."""
+"""cocotb bench: line_delay against :func:`eyestereo.tools.models.line_delay.line_delay`, bit for bit."""
 
 import cocotb
 
 from eyestereo.sim.bench import StreamTB, run_configured
-from eyestereo.tools import line_delay as model
+from eyestereo.tools.models import line_delay as model
 
 
 class LineDelayTB(StreamTB):

@@ -1,10 +1,10 @@
-"""cocotb bench: nms against :func:`eyestereo.tools.nms.nms`, bit for bit."""
+"""cocotb bench: nms against :func:`eyestereo.tools.models.nms.nms`, bit for bit."""
 
 import cocotb
 
 from eyestereo.sim.bench import StreamTB, run_configured
-from eyestereo.tools import cornerness as corner_model
-from eyestereo.tools import nms as model
+from eyestereo.tools.models import cornerness as corner_model
+from eyestereo.tools.models import nms as model
 
 
 class NmsTB(StreamTB):

@@ -1,4 +1,4 @@
-"""cocotb bench: prethreshold against :func:`eyestereo.tools.prethreshold.prethreshold`, bit for bit.
+"""cocotb bench: prethreshold against :func:`eyestereo.tools.models.prethreshold.prethreshold`, bit for bit.
 
 The config's ``thresholds`` (a dict block index -> code) are written through the register port after
 reset; blocks not written must act as threshold 0. With ``reset_after_write`` a second ``rst`` pulse
@@ -9,8 +9,8 @@ import cocotb
 import numpy as np
 
 from eyestereo.sim.bench import StreamTB, run_configured, write_thresholds
-from eyestereo.tools import cornerness as corner_model
-from eyestereo.tools import prethreshold as model
+from eyestereo.tools.models import cornerness as corner_model
+from eyestereo.tools.models import prethreshold as model
 
 
 class PrethresholdTB(StreamTB):

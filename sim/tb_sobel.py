@@ -1,9 +1,9 @@
-"""cocotb bench: sobel against :func:`eyestereo.tools.sobel.sobel`, bit for bit."""
+"""cocotb bench: sobel against :func:`eyestereo.tools.models.sobel.sobel`, bit for bit."""
 
 import cocotb
 
 from eyestereo.sim.bench import StreamTB, run_configured
-from eyestereo.tools import sobel as model
+from eyestereo.tools.models import sobel as model
 
 
 class SobelTB(StreamTB):

@@ -14,7 +14,7 @@ Two calling conventions are supported everywhere:
   destination format must then have ``wl <= 62`` (:data:`MAX_ARRAY_WL`).
 
 This module is deliberately free of any HDL dependency so that the bit-true
-software models can use it on their own; see ``eyestereo.hdl.fixed`` for the
+software models can use it on their own; see ``eyestereo.hdl.common.fixed`` for the
 MyHDL signal helpers.
 """
 

@@ -1,0 +1,153 @@
+"""Architecture rule: tools imports neither myhdl nor cocotb (nor hdl/sim); hdl never imports sim or cocotb.
+
+Checked twice: statically, by parsing every module with ``ast`` (also catches imports inside functions),
+and dynamically, by importing each tools module in a fresh interpreter and looking at ``sys.modules``.
+"""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+PACKAGES = {"tools": "eyestereo.tools", "hdl": "eyestereo.hdl"}
+
+FORBIDDEN = {
+    "tools": ("myhdl", "cocotb", "cocotb_tools", "eyestereo.hdl", "eyestereo.sim"),
+    "hdl": ("cocotb", "cocotb_tools", "eyestereo.sim"),
+}
+
+
+def py_files(folder: str) -> list[Path]:
+    return sorted((ROOT / folder).rglob("*.py"))
+
+
+def module_name(folder: str, path: Path) -> str:
+    rel = path.relative_to(ROOT / folder).with_suffix("")
+    parts = [p for p in rel.parts if p != "__init__"]
+    return ".".join([PACKAGES[folder], *parts])
+
+
+def imported_modules(path: Path, package: str) -> list[tuple[int, str]]:
+    """(line, absolute module name) of every import in the file, relative imports resolved against
+    ``package`` (the package holding the file; for an ``__init__.py``, the package itself).
+
+    ``from a import b`` yields both ``a`` and ``a.b`` (b may be a submodule). Calls of
+    ``importlib.import_module("x")`` and ``__import__("x")`` with a literal name count too.
+    """
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found += [(node.lineno, a.name) for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:  # relative to `package`, the package that contains the file
+                parts = package.split(".")
+                base = parts[: len(parts) - (node.level - 1)]
+                mod = ".".join(base + ([node.module] if node.module else []))
+            else:
+                mod = node.module or ""
+            found.append((node.lineno, mod))
+            found += [(node.lineno, f"{mod}.{a.name}") for a in node.names if a.name != "*"]
+        elif isinstance(node, ast.Call) and node.args and isinstance(node.args[0], ast.Constant):
+            f = node.func
+            name = f.attr if isinstance(f, ast.Attribute) else f.id if isinstance(f, ast.Name) else None
+            if name in ("import_module", "__import__") and isinstance(node.args[0].value, str):
+                found.append((node.lineno, node.args[0].value))
+    return found
+
+
+def is_forbidden(mod: str, forbidden: tuple[str, ...]) -> bool:
+    return any(mod == f or mod.startswith(f + ".") for f in forbidden)
+
+
+def violations(folder: str, path: Path) -> list[str]:
+    package = module_name(folder, path)
+    if path.name != "__init__.py":
+        package = package.rsplit(".", 1)[0]
+    return [f"{path.relative_to(ROOT)}:{line} imports {mod}"
+            for line, mod in imported_modules(path, package) if is_forbidden(mod, FORBIDDEN[folder])]
+
+
+# --------------------------------------------------------------------------------------------------
+# The checker itself
+
+
+def test_checker_finds_forbidden_imports(tmp_path):
+    bad = tmp_path / "bad.py"
+    bad.write_text(
+        "import numpy\n"
+        "import myhdl\n"
+        "from cocotb.triggers import RisingEdge\n"
+        "def f():\n"
+        "    from eyestereo.hdl import stream\n"
+        "    import importlib; importlib.import_module('cocotb_tools.runner')\n"
+        "from eyestereo import sim\n"
+        "from ..sim import bench\n"
+    )
+    mods = [m for _, m in imported_modules(bad, "eyestereo.tools")]
+    hits = sorted({m for m in mods if is_forbidden(m, FORBIDDEN["tools"])})
+    assert "numpy" not in hits
+    assert {"myhdl", "cocotb.triggers", "eyestereo.hdl", "cocotb_tools.runner", "eyestereo.sim",
+            "eyestereo.sim.bench"} <= set(hits)
+    assert not is_forbidden("myhdlish", ("myhdl",))
+    assert not is_forbidden("eyestereo.hdlx", ("eyestereo.hdl",))
+
+
+def test_relative_imports_resolve(tmp_path):
+    p = tmp_path / "mod.py"
+    p.write_text("from . import window\nfrom .stream import TOKEN\nfrom ..hdl.stream import ImageStream\n")
+    mods = {m for _, m in imported_modules(p, "eyestereo.tools")}
+    assert {"eyestereo.tools.window", "eyestereo.tools.stream", "eyestereo.hdl.stream"} <= mods
+
+
+def test_there_are_modules_to_check():
+    names = {p.name for p in py_files("tools")}
+    assert {"__init__.py", "stream.py", "sobel.py", "convolve.py"} <= names
+    assert {"__init__.py", "stream.py", "catalog.py"} <= {p.name for p in py_files("hdl")}
+
+
+# --------------------------------------------------------------------------------------------------
+# Static check
+
+
+@pytest.mark.parametrize("path", py_files("tools"), ids=lambda p: f"tools/{p.relative_to(ROOT / 'tools')}")
+def test_tools_module_imports_no_hdl_or_simulator(path):
+    assert violations("tools", path) == []
+
+
+@pytest.mark.parametrize("path", py_files("hdl"), ids=lambda p: f"hdl/{p.relative_to(ROOT / 'hdl')}")
+def test_hdl_module_imports_no_sim_or_cocotb(path):
+    assert violations("hdl", path) == []
+
+
+# --------------------------------------------------------------------------------------------------
+# Dynamic check
+
+CHECK = (
+    "import importlib, sys; importlib.import_module({mod!r}); "
+    "bad = sorted(m for m in sys.modules if m.split('.')[0] in ('myhdl', 'cocotb', 'cocotb_tools') "
+    "or m.startswith(('eyestereo.hdl', 'eyestereo.sim'))); "
+    "assert not bad, bad"
+)
+
+
+def run_check(mod: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-c", CHECK.format(mod=mod)], capture_output=True, text=True,
+                          cwd=ROOT, timeout=60)
+
+
+@pytest.mark.parametrize("mod", [module_name("tools", p) for p in py_files("tools")])
+def test_importing_tools_module_loads_no_myhdl_or_cocotb(mod):
+    r = run_check(mod)
+    assert r.returncode == 0, f"import {mod}:\n{r.stderr}"
+
+
+def test_dynamic_check_can_fail():
+    r = run_check("eyestereo.hdl.stream")  # imports myhdl, so the check must complain
+    assert r.returncode != 0
+    assert "myhdl" in r.stderr

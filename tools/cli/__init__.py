@@ -1,0 +1,2 @@
+"""The ``eyestereo`` command line (entry point :func:`eyestereo.tools.cli.main.main`): one module per
+group of subcommands."""

@@ -1,0 +1,1 @@
+"""Bit-true numpy models, one per hardware block, each named after its block in ``eyestereo.hdl``."""

@@ -1,0 +1,34 @@
+"""Bit-true model of :func:`eyestereo.hdl.nms.nms`: non-maximum suppression with a raster tie rule.
+
+A pixel is a feature when its value is > 0 and it beats every other pixel of the size x size window
+centred on it, where "beats" means: strictly greater than the neighbours that come before it in raster
+order (rows above; same row, to the left) and greater or equal to those after it. On a plateau of equal
+values that fits in the window, exactly one pixel survives: the plateau's first in raster order.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from eyestereo.tools.models.border import interior_mask
+
+
+def nms(values: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
+    """(feature flags 0/1, interior mask) for a frame of signed values."""
+    if size not in (1, 3, 5):
+        raise ValueError(f"nms size must be 1, 3 or 5, got {size}")
+    v = np.asarray(values, np.int64)
+    h, w = v.shape
+    r = size // 2
+    flags = v > 0
+    if r:
+        pad = np.full((h + 2 * r, w + 2 * r), np.iinfo(np.int64).min, dtype=np.int64)
+        pad[r:r + h, r:r + w] = v
+        for dy in range(-r, r + 1):
+            for dx in range(-r, r + 1):
+                if dy == 0 and dx == 0:
+                    continue
+                n = pad[r + dy:r + dy + h, r + dx:r + dx + w]
+                before = dy < 0 or (dy == 0 and dx < 0)
+                flags &= (v > n) if before else (v >= n)
+    return flags.astype(np.int64), interior_mask(h, w, r)

@@ -1,0 +1,1 @@
+"""Benchmark and report scripts that write the measured pages in ``docs/``."""
