@@ -23,6 +23,8 @@ from eyestereo.hdl.sobel import sobel
 from eyestereo.hdl.stream import ImageStream
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import harris_window as window_model
+from eyestereo.tools.models import nms as nms_model
+from eyestereo.tools.models import sobel as sobel_model
 from eyestereo.tools.models.convolve import check_kernel, output_width
 
 
@@ -72,7 +74,7 @@ def _thr_ports():
         return Signal(intbv(0)[max(1, (n - 1).bit_length()):])
 
     return (("thr_we", lambda p: Signal(bool(0))), ("thr_addr", addr),
-            ("thr_data", lambda p: Signal(intbv(0)[corner_model.OUT.wl:])))
+            ("thr_data", lambda p: Signal(intbv(0)[corner_model.WORD.width:])))
 
 
 def _conv_width(p):
@@ -94,29 +96,31 @@ BLOCKS: dict[str, BlockSpec] = {
     "sobel": BlockSpec(
         "sobel", "separable 3x3 Sobel, Ix and Iy as sfix[9,-3]", sobel,
         dict(width=352, height=288),
-        sink_width=lambda p: 8, source_width=lambda p: 18, hw_params=("width", "height")),
+        sink_width=lambda p: 8, source_width=lambda p: sobel_model.WORD.width, hw_params=("width", "height")),
     "harris_window": BlockSpec(
         "harris_window", "Ix^2, Iy^2, IxIy packed in 36 bits, summed over a 5x5 [1 2 4 2 1]^2 window",
         harris_window, dict(width=352, height=288),
-        sink_width=lambda p: 18, source_width=lambda p: window_model.OUT_BITS, hw_params=("width", "height")),
+        sink_width=lambda p: sobel_model.WORD.width, source_width=lambda p: window_model.WORD.width, hw_params=("width", "height")),
     "cornerness": BlockSpec(
         "cornerness", "det(G) - k trace(G)^2, 6-stage pipeline, 4 multipliers, 20-bit output", cornerness,
         dict(width=352, height=288),
-        sink_width=lambda p: window_model.OUT_BITS, source_width=lambda p: corner_model.OUT.wl,
+        sink_width=lambda p: window_model.WORD.width, source_width=lambda p: corner_model.WORD.width,
         hw_params=("width", "height"), control=(("k", _k_port),)),
     "prethreshold": BlockSpec(
         "prethreshold", "cornerness > its block's run-time threshold, else 0 (BX x BY blocks)", prethreshold,
         dict(width=352, height=288, blocks=(4, 4)),
-        sink_width=lambda p: corner_model.OUT.wl, source_width=lambda p: corner_model.OUT.wl,
+        sink_width=lambda p: corner_model.WORD.width, source_width=lambda p: corner_model.WORD.width,
         hw_params=("width", "height", "blocks"), control=_thr_ports()),
     "nms": BlockSpec(
         "nms", "separable non-maximum suppression 1x1/3x3/5x5 with a raster tie rule, 1-bit flags", nms,
         dict(width=352, height=288, size=3),
-        sink_width=lambda p: corner_model.OUT.wl, source_width=lambda p: 1, hw_params=("width", "height", "size")),
+        sink_width=lambda p: corner_model.WORD.width, source_width=lambda p: nms_model.WORD.width,
+        hw_params=("width", "height", "size")),
     "harris_mono": BlockSpec(
         "harris_mono", "Harris corners: Sobel -> window -> cornerness -> pre-threshold -> NMS", harris_mono,
         dict(width=352, height=288, blocks=(4, 4), nms=3),
-        sink_width=lambda p: 8, source_width=lambda p: 1, hw_params=("width", "height", "blocks", "nms"),
+        sink_width=lambda p: 8, source_width=lambda p: nms_model.WORD.width,
+        hw_params=("width", "height", "blocks", "nms"),
         control=(("k", _k_port),) + _thr_ports()),
 }
 

@@ -4,6 +4,7 @@ from myhdl import Signal, always, always_comb, block, intbv
 
 from eyestereo.hdl.common.fixed import fx_signal
 from eyestereo.hdl.common import delay_rst
+from eyestereo.hdl.common.packed import unpack_word
 from eyestereo.tools.models import cornerness as model
 from eyestereo.tools.models import harris_window as window_model
 from eyestereo.tools.stream import check_geometry
@@ -58,12 +59,6 @@ def cornerness(clk, rst, sink, source, k, *, width: int = 352, height: int = 288
 
     trace = Signal(intbv(0, min=0, max=2 * window_model.SUM_SQ.hi + 1))
 
-    @always_comb
-    def fields():
-        sxx.next = sink.data[19:0]
-        syy.next = sink.data[38:19]
-        sxy.next = sink.data[57:38]
-
     # A sum of its own: VHDL adds in the operands' width (19 bits), which would wrap.
     @always_comb
     def add():
@@ -106,7 +101,7 @@ def cornerness(clk, rst, sink, source, k, *, width: int = 352, height: int = 288
         else:
             cout.next = crs
 
-    insts = [fields, add, pipeline, clamp, saturate]
+    insts = [unpack_word(sink.data, window_model.WORD, sxx=sxx, syy=syy, sxy=sxy), add, pipeline, clamp, saturate]
     for s, d in ((sink.valid, source.valid), (sink.eol, source.eol), (sink.eof, source.eof)):
         insts.append(delay_rst(clk, rst, s, d, clocks=LATENCY))
     return insts

@@ -13,6 +13,7 @@ from eyestereo.hdl.sobel import sobel
 from eyestereo.hdl.stream import ImageStream
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import harris_window as window_model
+from eyestereo.tools.models import sobel as sobel_model
 from eyestereo.tools.models.harris_mono import check_params, k_code, radius, threshold_code  # noqa: F401 (re-export)
 from eyestereo.tools.stream import check_geometry
 
@@ -58,10 +59,10 @@ def harris_mono(clk, rst, sink, source, k, thr_we, thr_addr, thr_data, *, width:
         raise ValueError(f"harris_mono takes 8-bit pixels, sink has {len(sink.data)} bits")
     if len(source.data) != 1:
         raise ValueError(f"harris_mono source carries a 1-bit flag, has {len(source.data)} bits")
-    s_sobel = ImageStream(18)
-    s_window = ImageStream(window_model.OUT_BITS)
-    s_corner = ImageStream(corner_model.OUT.wl)
-    s_pre = ImageStream(corner_model.OUT.wl)
+    s_sobel = ImageStream(sobel_model.WORD)
+    s_window = ImageStream(window_model.WORD)
+    s_corner = ImageStream(corner_model.WORD)
+    s_pre = ImageStream(corner_model.WORD)
     return [
         sobel(clk, rst, sink, s_sobel, width=width, height=height),
         harris_window(clk, rst, s_sobel, s_window, width=width, height=height),

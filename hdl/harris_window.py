@@ -5,6 +5,8 @@ from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv
 from eyestereo.hdl.common.fixed import fx_signal
 from eyestereo.hdl.stream import ImageStream
 from eyestereo.hdl.common import range_signal, column_taps, delay, en_reg, shift_add, window_control
+from eyestereo.hdl.common.packed import pack_word, unpack_word
+from eyestereo.tools.models import sobel as sobel_model
 from eyestereo.tools.models import harris_window as model
 from eyestereo.tools.fixed import sfix
 from eyestereo.tools.stream import check_geometry
@@ -38,8 +40,9 @@ def harris_window(clk, rst, sink, source, *, width: int = 352, height: int = 288
     Resources: 3 multipliers (10x10), 4 line delays of 36 bits (4 RAMB16), adders and registers.
     """
     check_geometry(width, height, min_size=N)
-    if len(sink.data) != 18:
-        raise ValueError(f"harris_window takes 18-bit Sobel words (Iy, Ix), sink has {len(sink.data)} bits")
+    if len(sink.data) != sobel_model.WORD.width:
+        raise ValueError(f"harris_window takes {sobel_model.WORD.width}-bit Sobel words (Iy, Ix), "
+                         f"sink has {len(sink.data)} bits")
     if len(source.data) != model.OUT_BITS:
         raise ValueError(f"harris_window source carries {model.OUT_BITS} bits, has {len(source.data)}")
 
@@ -52,10 +55,14 @@ def harris_window(clk, rst, sink, source, *, width: int = 352, height: int = 288
     sq_top = model.PROD_SQ.hi
     xy_lo, xy_hi = model.PROD_XY.lo, model.PROD_XY.hi
 
+    # The midpoint 2c + 1 of each code: its bits with a 1 appended (the field positions of the Sobel word).
+    xh, xl = sobel_model.WORD.bits("ix")
+    yh, yl = sobel_model.WORD.bits("iy")
+
     @always_comb
     def fields():
-        mx.next = concat(sink.data[9:0], True)
-        my.next = concat(sink.data[18:9], True)
+        mx.next = concat(sink.data[xh:xl], True)
+        my.next = concat(sink.data[yh:yl], True)
 
     # The +16 rounds the cut by 32 below; it rides on the multiplier's output adder.
     @always_comb
@@ -82,11 +89,12 @@ def harris_window(clk, rst, sink, source, *, width: int = 352, height: int = 288
         else:
             qxy.next = fxy >> 5
 
-    prod = ImageStream(model.PACK_BITS)
+    prod = ImageStream(model.PRODUCTS)
+    prod_word = Signal(intbv(0)[model.PRODUCTS.width:])
 
     @always(clk.posedge)
     def pack():
-        prod.data.next = concat(qxy[12:], qyy[12:], qxx[12:])
+        prod.data.next = prod_word
 
     @always_seq(clk.posedge, reset=rst)
     def flags():
@@ -96,17 +104,18 @@ def harris_window(clk, rst, sink, source, *, width: int = 352, height: int = 288
 
     taps = [Signal(intbv(0)[model.PACK_BITS:]) for _ in range(N)]
     tap_valid = Signal(bool(0))
-    insts = [fields, multiply, saturate, pack, flags,
+    insts = [fields, multiply, saturate, pack_word(prod_word, model.PRODUCTS, pxx=qxx, pyy=qyy, pxy=qxy), pack, flags,
              column_taps(clk, rst, prod, taps, tap_valid, width=width, height=height)]
 
     weights = [int(w) for w in model.TAPS]
     col_valid = Signal(bool(0))
     insts.append(delay(clk, tap_valid, col_valid, clocks=1))
     sums = []
-    for lo_bit, fmt in ((0, model.PROD_SQ), (12, model.PROD_SQ), (24, model.PROD_XY)):
+    for product in model.PRODUCTS.fields:  # pxx, pyy, pxy: each summed over the window on its own
+        fmt = product.fmt
         fields_i = [fx_signal(fmt) for _ in range(N)]
         for tap, f in zip(taps, fields_i):
-            insts.append(field(tap, f, lo_bit))
+            insts.append(unpack_word(tap, model.PRODUCTS, **{product.name: f}))
         vlo = fmt.lo * sum(weights)
         vhi = fmt.hi * sum(weights)
         vsum, vreg = range_signal(vlo, vhi), range_signal(vlo, vhi)
@@ -120,22 +129,13 @@ def harris_window(clk, rst, sink, source, *, width: int = 352, height: int = 288
         insts.append(shift_add(list(zip(row, weights)), total))
         sums.append(total)
     sxx, syy, sxy = sums
+    out_word = Signal(intbv(0)[model.WORD.width:])
 
     @always(clk.posedge)
     def outreg():
-        source.data.next = concat(sxy[19:], syy[19:], sxx[19:])
+        source.data.next = out_word
 
-    insts += [outreg, window_control(clk, rst, prod, source, width=width, height=height, radius=N // 2,
+    insts += [pack_word(out_word, model.WORD, sxx=sxx, syy=syy, sxy=sxy), outreg, window_control(clk, rst, prod, source, width=width, height=height, radius=N // 2,
                                      latency=N + 2)]
     return insts
 
-
-@block
-def field(word, out, lo_bit: int):
-    hi_bit = lo_bit + len(out)
-
-    @always_comb
-    def extract():
-        out.next = word[hi_bit:lo_bit]
-
-    return extract

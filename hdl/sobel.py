@@ -1,11 +1,12 @@
 """Separable 3x3 Sobel gradients Ix, Iy by shifts and adds, quantized to sfix[9,-3] (thesis 6.2.1)."""
 
-from myhdl import Signal, always, block, concat, intbv
+from myhdl import Signal, always, block, intbv
 
 from eyestereo.hdl.common.fixed import fx_signal
 from eyestereo.hdl.common import range_signal, column_taps, delay, en_reg, shift_add, window_control
 from eyestereo.tools.fixed import shift_between
-from eyestereo.tools.models.sobel import GRAD, OUT
+from eyestereo.hdl.common.packed import pack_word
+from eyestereo.tools.models.sobel import GRAD, OUT, WORD
 from eyestereo.tools.stream import check_geometry
 
 LATENCY = 5
@@ -37,8 +38,8 @@ def sobel(clk, rst, sink, source, *, width: int = 352, height: int = 288):
     check_geometry(width, height, min_size=3)
     if len(sink.data) != 8:
         raise ValueError(f"sobel takes 8-bit pixels, sink has {len(sink.data)} data bits")
-    if len(source.data) != 18:
-        raise ValueError(f"sobel source carries 18 bits (Iy, Ix), has {len(source.data)}")
+    if len(source.data) != WORD.width:
+        raise ValueError(f"sobel source carries {WORD.width} bits (Iy, Ix), has {len(source.data)}")
 
     top, mid, bot = taps = [Signal(intbv(0)[8:]) for _ in range(3)]
     tap_valid = Signal(bool(0))
@@ -71,7 +72,7 @@ def sobel(clk, rst, sink, source, *, width: int = 352, height: int = 288):
     qx = fx_signal(OUT)
     qy = fx_signal(OUT)
     sh = shift_between(GRAD.fl, OUT.fl)
-    nb = OUT.wl
+    word = Signal(intbv(0)[WORD.width:])
 
     @always(gx, gy)
     def quantize():
@@ -80,8 +81,8 @@ def sobel(clk, rst, sink, source, *, width: int = 352, height: int = 288):
 
     @always(clk.posedge)
     def outreg():
-        source.data.next = concat(qy[nb:], qx[nb:])
+        source.data.next = word
 
-    insts += [quantize, outreg,
+    insts += [quantize, pack_word(word, WORD, ix=qx, iy=qy), outreg,
               window_control(clk, rst, sink, source, width=width, height=height, radius=1, latency=LATENCY)]
     return insts

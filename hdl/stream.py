@@ -8,8 +8,9 @@ Fields (VHDL/Verilog ports come out as ``<arg>_<field>``, e.g. ``sink_data``, ``
 
 ``data``
     The pixel, ``data_width`` bits, unsigned bit vector. Blocks that carry several or signed values pack
-    them into it and say how in their docstring (e.g. Sobel: ``Iy`` in bits 17..9, ``Ix`` in 8..0, two's
-    complement).
+    them into it as a :class:`~eyestereo.tools.packed.PackedWord`, declared once next to the block's model
+    (e.g. ``eyestereo.tools.models.sobel.WORD``: ``Iy`` in bits 17..9, ``Ix`` in 8..0, two's complement);
+    ``ImageStream(WORD)`` sizes the stream from it.
 ``valid``
     The other fields mean something only while ``valid`` is high. Idle cycles (``valid`` low) may come
     anywhere, as many as the source likes, also inside a line.
@@ -38,20 +39,32 @@ emits frames of the geometry its docstring states (the sink's, for all filters),
 valid/eol/eof pattern per frame, after a latency given in the block's docstring.
 """
 
+import numbers
+
 from myhdl import Signal, intbv
+
+from eyestereo.tools.packed import PackedWord
 
 
 class ImageStream:
     """A MyHDL interface bundle for one image stream (see the module docstring for the protocol).
 
     Parameters:
-        data_width: bits of ``data`` (>= 1).
+        data_width: bits of ``data`` (>= 1), or the :class:`~eyestereo.tools.packed.PackedWord` the
+            stream carries (its width is taken, and the word is kept as ``stream.word``).
         stereo: add the ``cam`` field.
     """
 
-    def __init__(self, data_width: int = 8, *, stereo: bool = False):
-        if isinstance(data_width, bool) or not isinstance(data_width, int) or data_width < 1:
-            raise ValueError(f"ImageStream data_width must be an int >= 1, got {data_width!r}")
+    def __init__(self, data_width: int | PackedWord = 8, *, stereo: bool = False):
+        self.word = None
+        if isinstance(data_width, PackedWord):
+            self.word = data_width
+            data_width = data_width.width
+        if isinstance(data_width, bool) or not isinstance(data_width, numbers.Integral) or data_width < 1:
+            raise ValueError(f"ImageStream data_width must be an int >= 1 or a PackedWord, got {data_width!r}")
+        if not isinstance(stereo, bool):
+            raise ValueError(f"ImageStream stereo must be True or False, got {stereo!r}")
+        data_width = int(data_width)
         self.data_width = data_width
         self.stereo = stereo
         self.data = Signal(intbv(0)[data_width:])

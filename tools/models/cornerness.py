@@ -33,6 +33,7 @@ from __future__ import annotations
 import numpy as np
 
 from eyestereo.tools.fixed import sfix, ufix
+from eyestereo.tools.packed import PackedWord
 from eyestereo.tools.models.harris_window import unpack as window_unpack
 
 K = ufix(8, 8)
@@ -40,6 +41,8 @@ K = ufix(8, 8)
 #: Sobel gradients in grey levels, window normalised by 128) the binary point sits at -21.
 OUT = sfix(20, -21)
 OUT_SHIFT = 13
+#: The stream word: the cornerness code, two's complement.
+WORD = PackedWord("cornerness", [("c", OUT)])
 LATENCY = 6
 STAGES = {
     "a": ufix(17), "b": ufix(17), "c": sfix(17), "t": ufix(17),
@@ -76,9 +79,10 @@ def cornerness(window_words: np.ndarray, k: int) -> np.ndarray:
 
 
 def to_word(values: np.ndarray) -> np.ndarray:
-    return np.asarray(values, np.int64) & ((1 << OUT.wl) - 1)
+    """Stream words (:data:`WORD`) from cornerness codes."""
+    return WORD.pack(c=values)
 
 
 def from_word(words: np.ndarray) -> np.ndarray:
-    w = np.asarray(words, np.int64) & ((1 << OUT.wl) - 1)
-    return np.where(w >= 1 << (OUT.wl - 1), w - (1 << OUT.wl), w)
+    """Cornerness codes from stream words."""
+    return WORD.unpack(words)["c"]

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from eyestereo.tools.fixed import sfix, ufix
+from eyestereo.tools.packed import PackedWord
 from eyestereo.tools.models.sobel import unpack as sobel_unpack
 from eyestereo.tools.models.border import correlate_int, interior_mask
 
@@ -27,8 +28,12 @@ PROD_SQ = ufix(12, -9)   # (2 Ix + 1)^2 / 32, i.e. the squared gradient midpoint
 PROD_XY = sfix(12, -9)   # (2 Ix + 1)(2 Iy + 1) / 32
 SUM_SQ = ufix(19, -2)    # 100 * 4095 = 409500 < 2**19; fl = -9 + 7 for the /128
 SUM_XY = sfix(19, -2)    # 100 * [-2048, 2047] fits 19 signed bits
-PACK_BITS = 36           # product word through the line delays: Ixy | Iyy | Ixx, 12 bits each
-OUT_BITS = 3 * 19        # output word: Sxy (bits 56..38) | Syy (37..19) | Sxx (18..0)
+#: The product word through the line delays: Pxx in bits 11..0, Pyy in 23..12, Pxy in 35..24.
+PRODUCTS = PackedWord("harris_window products", [("pxx", PROD_SQ), ("pyy", PROD_SQ), ("pxy", PROD_XY)])
+#: The output word: Sxx in bits 18..0, Syy in 37..19, Sxy in 56..38 (two's complement).
+WORD = PackedWord("harris_window", [("sxx", SUM_SQ), ("syy", SUM_SQ), ("sxy", SUM_XY)])
+PACK_BITS = PRODUCTS.width  # 36
+OUT_BITS = WORD.width       # 57
 
 
 def products(ix: np.ndarray, iy: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -52,17 +57,14 @@ def harris_window_sums(ix: np.ndarray, iy: np.ndarray) -> tuple[np.ndarray, np.n
 
 
 def pack(sxx: np.ndarray, syy: np.ndarray, sxy: np.ndarray) -> np.ndarray:
-    m = (1 << 19) - 1
-    return (np.asarray(sxx, np.int64) & m) | ((np.asarray(syy, np.int64) & m) << 19) | \
-        ((np.asarray(sxy, np.int64) & m) << 38)
+    """The 57-bit output word (:data:`WORD`) from the three sums."""
+    return WORD.pack(sxx=sxx, syy=syy, sxy=sxy)
 
 
 def unpack(words: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    w = np.asarray(words, dtype=np.int64)
-    m = (1 << 19) - 1
-    sxy = (w >> 38) & m
-    sxy = np.where(sxy >= 1 << 18, sxy - (1 << 19), sxy)
-    return w & m, (w >> 19) & m, sxy
+    """(sxx, syy, sxy) from output words."""
+    f = WORD.unpack(words)
+    return f["sxx"], f["syy"], f["sxy"]
 
 
 def harris_window(sobel_words: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -11,6 +11,10 @@ from __future__ import annotations
 import numpy as np
 
 from eyestereo.tools.models.border import interior_mask
+from eyestereo.tools.packed import PackedWord
+
+#: The output word: one feature flag per pixel.
+WORD = PackedWord("nms", [("corner", 1)])
 
 
 def nms(values: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:

@@ -3,6 +3,7 @@
 import numpy as np
 
 from eyestereo.tools.fixed import requantize, sfix
+from eyestereo.tools.packed import PackedWord
 from eyestereo.tools.models.border import correlate_int, interior_mask
 
 #: Ix kernel (right minus left, as OpenCV's Sobel with dx=1); Iy is its transpose (down minus up).
@@ -14,6 +15,8 @@ GRAD = sfix(11, 0)
 OUT = sfix(9, -3)
 OUT_BITS = OUT.wl
 OUT_FL = OUT.fl
+#: The stream word: Ix in bits 8..0, Iy in bits 17..9, two's complement codes of sfix[9,-3].
+WORD = PackedWord("sobel", [("ix", OUT), ("iy", OUT)])
 
 
 def sobel(frame: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -27,17 +30,11 @@ def sobel(frame: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def pack(ix: np.ndarray, iy: np.ndarray) -> np.ndarray:
-    """The 18-bit stream word: Iy in bits 17..9, Ix in bits 8..0, two's complement."""
-    m = (1 << OUT_BITS) - 1
-    return ((np.asarray(iy, dtype=np.int64) & m) << OUT_BITS) | (np.asarray(ix, dtype=np.int64) & m)
+    """The 18-bit stream word (:data:`WORD`) from Ix and Iy codes."""
+    return WORD.pack(ix=ix, iy=iy)
 
 
 def unpack(words: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(ix, iy) signed codes from 18-bit stream words."""
-    w = np.asarray(words, dtype=np.int64)
-    m = (1 << OUT_BITS) - 1
-
-    def sx(v):
-        return np.where(v >= 1 << (OUT_BITS - 1), v - (1 << OUT_BITS), v)
-
-    return sx(w & m), sx((w >> OUT_BITS) & m)
+    f = WORD.unpack(words)
+    return f["ix"], f["iy"]
