@@ -19,6 +19,7 @@ from eyestereo.hdl.harris_window import harris_window
 from eyestereo.hdl.nms import nms
 from eyestereo.hdl.prethreshold import prethreshold
 from eyestereo.hdl.line_delay import line_delay
+from eyestereo.hdl.poly_unit import CoefPort, poly_unit
 from eyestereo.hdl.sobel import sobel
 from eyestereo.hdl.stream import ImageStream
 from eyestereo.tools.models import cornerness as corner_model
@@ -26,6 +27,7 @@ from eyestereo.tools.models import harris_window as window_model
 from eyestereo.tools.models import nms as nms_model
 from eyestereo.tools.models import sobel as sobel_model
 from eyestereo.tools.models.convolve import check_kernel, output_width
+from eyestereo.tools.models import poly_unit as poly_model
 
 
 @dataclass(frozen=True)
@@ -34,11 +36,19 @@ class BlockSpec:
     summary: str
     func: Callable
     defaults: dict
-    sink_width: Callable[[dict], int]
-    source_width: Callable[[dict], int]
+    sink_width: Callable[[dict], int] | None = None
+    source_width: Callable[[dict], int] | None = None
     hw_params: tuple[str, ...] = field(default=())  # parameters passed to the block function
     #: control ports after ``source``, in order: name -> function(params) -> fresh Signal
     control: tuple[tuple[str, Callable[[dict], object]], ...] = field(default=())
+    #: Blocks without an image stream: function(params) -> {port name: fresh Signal or interface} in
+    #: the block's order after clk and rst (then sink_width/source_width/control are unused).
+    ports: Callable[[dict], dict] | None = None
+
+    @property
+    def is_stream(self) -> bool:
+        """Whether the block has the stream ports sink and source (else its ports come from ``ports``)."""
+        return self.ports is None
 
     def params(self, **overrides) -> dict:
         unknown = set(overrides) - set(self.defaults)
@@ -53,6 +63,11 @@ class BlockSpec:
         p = self.params(**overrides)
         clk = Signal(bool(0))
         rst = ResetSignal(0, active=1, isasync=False)
+        kw = {k: v for k, v in p.items() if k in self.hw_params}
+        if self.ports is not None:
+            ports = self.ports(p)
+            inst = self.func(clk, rst, *ports.values(), **kw)
+            return inst, dict(clk=clk, rst=rst, **ports), p
         sink = ImageStream(self.sink_width(p))
         source = ImageStream(self.source_width(p))
         kw = {k: v for k, v in p.items() if k in self.hw_params}
@@ -80,6 +95,33 @@ def _thr_ports():
 def _conv_width(p):
     k, _ = check_kernel(p.get("kernel"), p.get("col"), p.get("row"))
     return output_width(k, p["data_width"], p["shift"])[0]
+
+
+#: Rectification blocks: ``quantizers`` is a calibration spec or a quantizers.json path
+#: (:func:`eyestereo.tools.rectify.calibrations.load`; "rig" = the synthetic rig, 352x288).
+_POLY_DEFAULTS = dict(quantizers="rig", frac=poly_model.DEFAULT_FRAC, source_width=None, source_height=None,
+                      coefficients="constant")
+
+
+def _calibration(p):
+    from eyestereo.hdl.poly_unit import calibration_param
+
+    return calibration_param(p["quantizers"], p["source_width"], p["source_height"])
+
+
+def _coef_port(p, cal):
+    if p["coefficients"] not in ("constant", "register"):
+        raise ValueError(f"parameter coefficients must be 'constant' or 'register', got {p['coefficients']!r}")
+    return {"coef": CoefPort(poly_model.coef_data_bits(cal.formats))} if p["coefficients"] == "register" else {}
+
+
+def _poly_ports(p):
+    cal = _calibration(p)
+    nb = poly_model.coord_bits(cal, p["frac"])
+    return dict(enable=Signal(bool(0)), x=Signal(intbv(0)[poly_model.int_bits(cal.width):]),
+                y=Signal(intbv(0)[poly_model.int_bits(cal.height):]), select_coord=Signal(intbv(0)[3:]),
+                coord=Signal(intbv(0)[nb:]), out_of_range=Signal(bool(0)), select_coord_out=Signal(intbv(0)[3:]),
+                **_coef_port(p, cal))
 
 
 BLOCKS: dict[str, BlockSpec] = {
@@ -116,6 +158,10 @@ BLOCKS: dict[str, BlockSpec] = {
         dict(width=352, height=288, size=3),
         sink_width=lambda p: corner_model.WORD.width, source_width=lambda p: nms_model.WORD.width,
         hw_params=("width", "height", "size")),
+    "poly_unit": BlockSpec(
+        "poly_unit", "the four rectification polynomials, 8-stage pipeline, 9 multipliers, 1 coordinate/clock",
+        poly_unit, _POLY_DEFAULTS,
+        hw_params=("quantizers", "frac", "source_width", "source_height"), ports=_poly_ports),
     "harris_mono": BlockSpec(
         "harris_mono", "Harris corners: Sobel -> window -> cornerness -> pre-threshold -> NMS", harris_mono,
         dict(width=352, height=288, blocks=(4, 4), nms=3),
@@ -125,11 +171,17 @@ BLOCKS: dict[str, BlockSpec] = {
 }
 
 
+#: Simulation-only top levels (a bench harness around a block, registered by its module in
+#: ``eyestereo.sim``): :func:`get` finds them, ``make vhdl`` / ``make synth`` do not build them.
+BENCH_TOPS: dict[str, BlockSpec] = {}
+
+
 def get(name: str) -> BlockSpec:
-    try:
+    if name in BLOCKS:
         return BLOCKS[name]
-    except KeyError:
-        raise ValueError(f"unknown block {name!r}; blocks are {sorted(BLOCKS)}") from None
+    if name in BENCH_TOPS:
+        return BENCH_TOPS[name]
+    raise ValueError(f"unknown block {name!r}; blocks are {sorted(BLOCKS)}")
 
 
 def jsonable(p: dict) -> dict:
