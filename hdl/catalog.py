@@ -18,6 +18,8 @@ from eyestereo.hdl.harris_mono import harris_mono
 from eyestereo.hdl.harris_window import harris_window
 from eyestereo.hdl.nms import nms
 from eyestereo.hdl.prethreshold import prethreshold
+from eyestereo.hdl.coord_pair import CoordPair
+from eyestereo.hdl.coordinate_warper import coordinate_warper
 from eyestereo.hdl.line_delay import line_delay
 from eyestereo.hdl.poly_unit import CoefPort, poly_unit
 from eyestereo.hdl.sobel import sobel
@@ -124,6 +126,12 @@ def _poly_ports(p):
                 **_coef_port(p, cal))
 
 
+def _warper_ports(p):
+    cal = _calibration(p)
+    return dict(start=Signal(bool(0)), enable=Signal(bool(0)), busy=Signal(bool(0)), done=Signal(bool(0)),
+                coord=CoordPair(cal.source_width, cal.source_height, p["frac"]), **_coef_port(p, cal))
+
+
 BLOCKS: dict[str, BlockSpec] = {
     "line_delay": BlockSpec(
         "line_delay", "one-line FIFO in block RAM: pixel (x, y-1) at (x, y)", line_delay,
@@ -162,6 +170,10 @@ BLOCKS: dict[str, BlockSpec] = {
         "poly_unit", "the four rectification polynomials, 8-stage pipeline, 9 multipliers, 1 coordinate/clock",
         poly_unit, _POLY_DEFAULTS,
         hw_params=("quantizers", "frac", "source_width", "source_height"), ports=_poly_ports),
+    "coordinate_warper": BlockSpec(
+        "coordinate_warper", "x/y counters, poly_unit and the double-buffered coordinate pair output (4 clocks/pair)",
+        coordinate_warper, _POLY_DEFAULTS,
+        hw_params=("quantizers", "frac", "source_width", "source_height"), ports=_warper_ports),
     "harris_mono": BlockSpec(
         "harris_mono", "Harris corners: Sobel -> window -> cornerness -> pre-threshold -> NMS", harris_mono,
         dict(width=352, height=288, blocks=(4, 4), nms=3),
