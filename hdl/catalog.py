@@ -129,7 +129,8 @@ def _poly_ports(p):
 def _warper_ports(p):
     cal = _calibration(p)
     return dict(start=Signal(bool(0)), enable=Signal(bool(0)), busy=Signal(bool(0)), done=Signal(bool(0)),
-                coord=CoordPair(cal.source_width, cal.source_height, p["frac"]), **_coef_port(p, cal))
+                coord=CoordPair(cal.source_width, cal.source_height, poly_model.resolve_frac(cal, p["frac"])),
+                **_coef_port(p, cal))
 
 
 BLOCKS: dict[str, BlockSpec] = {

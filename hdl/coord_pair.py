@@ -70,7 +70,7 @@ class CoordPair:
 
     FIELDS = ("valid", "read_ack", "xl", "yl", "xr", "yr", "oor_l", "oor_r", "eol", "eof")
 
-    def __init__(self, source_width: int, source_height: int, frac: int = model.DEFAULT_FRAC):
+    def __init__(self, source_width: int, source_height: int, frac: int):
         self.source_width = check_int("source_width", source_width, 2, 65536)
         self.source_height = check_int("source_height", source_height, 2, 65536)
         self.frac = check_int("frac", frac, 0, model.MAX_FRAC)

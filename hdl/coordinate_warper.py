@@ -30,7 +30,7 @@ def tag_delay(clk, en, din, dout, *, clocks: int):
 
 @block
 def coordinate_warper(clk, rst, start, enable, busy, done, coord, coef=None, *, quantizers=None,
-                      frac: int = unit_model.DEFAULT_FRAC, source_width: int | None = None,
+                      frac: int | None = unit_model.DEFAULT_FRAC, source_width: int | None = None,
                       source_height: int | None = None):
     """Source coordinates of every rectified pixel of both cameras, one pair (Pl, Pr) per pixel.
 
@@ -88,7 +88,7 @@ def coordinate_warper(clk, rst, start, enable, busy, done, coord, coef=None, *, 
 
     Parameters:
         quantizers, frac, source_width, source_height: as for :func:`~eyestereo.hdl.poly_unit.poly_unit`
-            (default: the synthetic rig, 352x288, frac 5). The rectified size (the counters) is the
+            (default: the synthetic rig, 352x288, frac = q24's fraction length, 5). The rectified size (the counters) is the
             calibration's ``width`` x ``height``.
 
     Latency: the first pair is offered 13 clocks after the ``start`` clock (:data:`FIRST_PAIR`); then one
@@ -99,8 +99,8 @@ def coordinate_warper(clk, rst, start, enable, busy, done, coord, coef=None, *, 
     """
     check_clock(clk)
     check_reset(rst)
-    frac = check_int("frac", frac, 0, unit_model.MAX_FRAC)
     cal = calibration_param(quantizers, source_width, source_height)
+    frac = unit_model.resolve_frac(cal, None if frac is None else check_int("frac", frac, 0, unit_model.MAX_FRAC))
     for name, sig in (("start", start), ("enable", enable), ("busy", busy), ("done", done)):
         check_signal(name, sig, width=1)
     if not isinstance(coord, CoordPair):

@@ -124,7 +124,7 @@ def low2(sel, index):
 
 @block
 def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_coord_out, coef=None, *,
-              quantizers=None, frac: int = model.DEFAULT_FRAC, source_width: int | None = None,
+              quantizers=None, frac: int | None = model.DEFAULT_FRAC, source_width: int | None = None,
               source_height: int | None = None):
     """Four degree-3 polynomials in one 8-stage pipeline with 9 multipliers: one coordinate per clock.
 
@@ -173,8 +173,9 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
         quantizers: the calibration: a ``quantizers.json`` path or document, a spec of
             :func:`eyestereo.tools.rectify.calibrations.load` (default ``"rig"``: the synthetic rig,
             352x288) or a :class:`~eyestereo.tools.models.poly_unit.Calibration`.
-        frac: fraction bits of ``coord`` (0..16; default 5, from the interpolation study in
-            docs/rectifier.md).
+        frac: fraction bits of ``coord`` (0..16). Default ``None``: q24's own fraction length (5 for the
+            synthetic rig, 6 for the OpenCV calibration at 640x480), which the interpolation study in
+            docs/rectifier.md picks: fewer bits add image error, more bits add only zeros.
         source_width, source_height: the camera images the coordinates point into (default: the
             document's ``source_width``/``source_height``, else its rectified size).
 
@@ -187,8 +188,8 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
     """
     check_clock(clk)
     check_reset(rst)
-    frac = check_int("frac", frac, 0, model.MAX_FRAC)
     cal = calibration_param(quantizers, source_width, source_height)
+    frac = model.resolve_frac(cal, None if frac is None else check_int("frac", frac, 0, model.MAX_FRAC))
     fm = cal.formats
     xbits, ybits = model.int_bits(cal.width), model.int_bits(cal.height)
     nb = model.coord_bits(cal, frac)

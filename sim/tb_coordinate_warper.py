@@ -35,8 +35,8 @@ class WarperTB:
         self.dut = dut
         self.cfg = cfg
         p = cfg["params"]
-        self.frac = int(p.get("frac", unit_model.DEFAULT_FRAC))
         self.cal = calibration(p)
+        self.frac = unit_model.resolve_frac(self.cal, p.get("frac"))
         self.batch = int(p.get("batch", 16))
         self.word = model.pair_word(self.cal, self.frac)
         self.clk = dut.clk

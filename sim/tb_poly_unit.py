@@ -57,8 +57,8 @@ async def write_coefficients(dut, clk, writes) -> None:
 async def poly_unit_random(dut):
     cfg = load_config()
     p = cfg["params"]
-    frac = int(p.get("frac", model.DEFAULT_FRAC))
     cal = calibration(p)
+    frac = model.resolve_frac(cal, p.get("frac"))
     rng = np.random.default_rng(int(cfg.get("seed", 0)))
     n = int(cfg.get("cycles", 2000))
     en_p, valid_p = float(cfg.get("en_p", 1.0)), float(cfg.get("valid_p", 0.8))

@@ -58,12 +58,13 @@ def lfsr32(clk, rst, seed, state):
 @block
 def coordinate_warper_tb(clk, rst, start, busy, done, ack_p, ack_reg, burst, en_p, seed, rec_strobe, rec_data,
                          rec_shift, rec_count, err, cycle, takes, first_take, last_take, coef=None, *,
-                         quantizers=None, frac: int = unit_model.DEFAULT_FRAC, source_width=None,
+                         quantizers=None, frac: int | None = unit_model.DEFAULT_FRAC, source_width=None,
                          source_height=None, batch: int = 16):
     """The warper between an LFSR-driven consumer and enable, with a batching recorder (module docstring)."""
     from eyestereo.hdl.poly_unit import calibration_param
 
     cal = calibration_param(quantizers, source_width, source_height)
+    frac = unit_model.resolve_frac(cal, frac)
     coord = CoordPair(cal.source_width, cal.source_height, frac)
     enable = Signal(bool(0))
     dut = coordinate_warper(clk, rst, start, enable, busy, done, coord, coef, quantizers=cal, frac=frac)
@@ -157,7 +158,7 @@ def coordinate_warper_tb(clk, rst, start, busy, done, ack_p, ack_reg, burst, en_
 
 def _ports(p):
     cal = _calibration(p)
-    pw = pair_bits(cal, p["frac"])
+    pw = pair_bits(cal, unit_model.resolve_frac(cal, p["frac"]))
     b = p["batch"]
     ports = dict(start=Signal(bool(0)), busy=Signal(bool(0)), done=Signal(bool(0)), ack_p=Signal(intbv(0)[9:]),
                  ack_reg=Signal(bool(0)), burst=Signal(bool(0)), en_p=Signal(intbv(0)[9:]),

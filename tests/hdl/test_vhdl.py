@@ -26,7 +26,15 @@ def test_make_vhdl_writes_and_analyses_every_block(tmp_path):
     for b in manifest["blocks"]:
         assert (tmp_path / f"{b['entity']}.vhd").exists()
         names = [p["name"] for p in b["ports"]]
-        control = [n for n, _ in BLOCKS[b["entity"]].control]
+        assert b["files"][0] == manifest["package"]
+        spec = BLOCKS[b["entity"]]
+        if not spec.is_stream:  # its own ports: every field of an interface flattened to <port>_<field>
+            ports = spec.ports(spec.params())
+            want = {"clk", "rst"} | {f"{n}_{f}" if hasattr(v, "fields") else n
+                                     for n, v in ports.items() for f in (v.fields() if hasattr(v, "fields") else [n])}
+            assert set(names) == want, b["entity"]
+            continue
+        control = [n for n, _ in spec.control]
         # MyHDL lists plain signal ports (clk, rst, control) before the flattened stream interfaces.
         assert names == ["clk", "rst"] + control + ["sink_data", "sink_valid", "sink_eol", "sink_eof",
                                                      "source_data", "source_valid", "source_eol", "source_eof"]

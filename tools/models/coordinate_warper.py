@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from eyestereo.tools.models.poly_unit import DEFAULT_FRAC, Calibration, coord_format, evaluate
+from eyestereo.tools.models.poly_unit import DEFAULT_FRAC, Calibration, coord_format, evaluate, resolve_frac
 from eyestereo.tools.packed import PackedWord
 
 __all__ = ["PAIR_FIELDS", "coordinate_warper", "decode_words", "pair_word", "pairs"]
@@ -25,14 +25,15 @@ __all__ = ["PAIR_FIELDS", "coordinate_warper", "decode_words", "pair_word", "pai
 PAIR_FIELDS = ("xl", "yl", "xr", "yr", "oor_l", "oor_r", "eol", "eof")
 
 
-def pair_word(cal: Calibration, frac: int = DEFAULT_FRAC) -> PackedWord:
+def pair_word(cal: Calibration, frac: int | None = DEFAULT_FRAC) -> PackedWord:
     """The pair as a packed word: X-L, Y-L, X-R, Y-R (ufix[n, frac]), then the four flags."""
+    frac = resolve_frac(cal, frac)
     fx, fy = coord_format(frac, cal.source_width), coord_format(frac, cal.source_height)
     return PackedWord("coord_pair", [("xl", fx), ("yl", fy), ("xr", fx), ("yr", fy),
                                      ("oor_l", 1), ("oor_r", 1), ("eol", 1), ("eof", 1)])
 
 
-def coordinate_warper(cal: Calibration, frac: int = DEFAULT_FRAC) -> dict[str, npt.NDArray[np.int64]]:
+def coordinate_warper(cal: Calibration, frac: int | None = DEFAULT_FRAC) -> dict[str, npt.NDArray[np.int64]]:
     """Every field of the pair of every rectified pixel, ``(height, width)`` int64 arrays."""
     ev = evaluate(cal, frac)
     h, w = cal.height, cal.width
@@ -45,7 +46,7 @@ def coordinate_warper(cal: Calibration, frac: int = DEFAULT_FRAC) -> dict[str, n
             "oor_r": ev["right_x"]["oor"] | ev["right_y"]["oor"], "eol": eol, "eof": eof}
 
 
-def pairs(cal: Calibration, frac: int = DEFAULT_FRAC, frames: int = 1) -> dict[str, npt.NDArray[np.int64]]:
+def pairs(cal: Calibration, frac: int | None = DEFAULT_FRAC, frames: int = 1) -> dict[str, npt.NDArray[np.int64]]:
     """The pairs in the order the warper offers them (``frames`` frames): flat arrays per field."""
     f = coordinate_warper(cal, frac)
     return {k: np.tile(v.ravel(), frames) for k, v in f.items()}

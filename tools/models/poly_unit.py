@@ -37,18 +37,29 @@ from eyestereo.tools.rectify.ffc import N_QUANTIZERS, POLY_NAMES, FFCError, fixe
 
 __all__ = ["DEFAULT_FRAC", "LATENCY", "SELECT", "VALID", "Calibration", "coef_addr_bits", "coef_data_bits",
            "coord_bits", "coord_format", "cut", "evaluate", "int_bits", "poly_unit", "q24_codes", "range_limit",
-           "register_writes"]
+           "register_writes", "resolve_frac"]
 
 #: Pipeline depth of the hardware unit: input register, the six arithmetic stages of the levelized
 #: listing (products, sums, products, sums, products, output sum), and the range check / cut.
 LATENCY = 8
-#: Default fraction bits of the output coordinate (docs/rectifier.md, "Interpolation precision").
-DEFAULT_FRAC = 5
+#: Default fraction bits of the output coordinate: ``None`` = q24's own fraction length (clamped to
+#: 0..MAX_FRAC), which the interpolation study (docs/rectifier.md) picks on every calibration: fewer bits
+#: add error, more add only zeros. The synthetic rig (352x288) gets 5, the OpenCV calibration (640x480) 6.
+DEFAULT_FRAC = None
 #: Polynomial index (= select & 3) of each polynomial.
 SELECT = {name: i for i, name in enumerate(POLY_NAMES)}
 VALID = 0b100
 #: Largest ``frac`` the blocks accept.
 MAX_FRAC = 16
+
+
+def resolve_frac(cal: "Calibration", frac: int | None = DEFAULT_FRAC) -> int:
+    """``frac``, or for ``None`` the default: q24's fraction length, clamped to 0..MAX_FRAC."""
+    if frac is None:
+        return min(max(cal.out_format.fl, 0), MAX_FRAC)
+    if isinstance(frac, bool) or not isinstance(frac, (int, np.integer)) or not 0 <= int(frac) <= MAX_FRAC:
+        raise ValueError(f"frac must be an integer 0..{MAX_FRAC} or None, got {frac!r}")
+    return int(frac)
 
 
 def int_bits(size: int) -> int:
@@ -169,12 +180,13 @@ def _limits(cal: Calibration) -> tuple[int, int]:
     return range_limit(cal.out_format, cal.source_width), range_limit(cal.out_format, cal.source_height)
 
 
-def evaluate(cal: Calibration, frac: int = DEFAULT_FRAC) -> dict[str, dict[str, npt.NDArray[np.int64]]]:
+def evaluate(cal: Calibration, frac: int | None = DEFAULT_FRAC) -> dict[str, dict[str, npt.NDArray[np.int64]]]:
     """Every polynomial at every rectified pixel, as the coordinate warper's registers hold them.
 
     ``{name: {"q24": codes, "coord": cut codes, "oor": 0/1}}``, each ``(height, width)``; ``coord`` has
     ``coord_format(frac, S).wl`` bits, S = source width for x, source height for y.
     """
+    frac = resolve_frac(cal, frac)
     lim_x, lim_y = _limits(cal)
     out = {}
     for index, name in enumerate(POLY_NAMES):
@@ -187,13 +199,13 @@ def evaluate(cal: Calibration, frac: int = DEFAULT_FRAC) -> dict[str, dict[str, 
     return out
 
 
-def coord_bits(cal: Calibration, frac: int) -> int:
+def coord_bits(cal: Calibration, frac: int | None = DEFAULT_FRAC) -> int:
     """Width of the unit's ``coord`` output: enough for x and y coordinates."""
-    return max(int_bits(cal.source_width), int_bits(cal.source_height)) + frac
+    return max(int_bits(cal.source_width), int_bits(cal.source_height)) + resolve_frac(cal, frac)
 
 
 def poly_unit(cal: Calibration, x: npt.ArrayLike, y: npt.ArrayLike, select: npt.ArrayLike,
-              frac: int = DEFAULT_FRAC) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+              frac: int | None = DEFAULT_FRAC) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
     """(coord, out_of_range) for a sequence of unit inputs (x, y counter values, select codes).
 
     The output for input ``k`` leaves the unit ``LATENCY`` enabled clocks later with ``select[k]``; the
@@ -209,6 +221,7 @@ def poly_unit(cal: Calibration, x: npt.ArrayLike, y: npt.ArrayLike, select: npt.
     gw, gh = 1 << int_bits(cal.width), 1 << int_bits(cal.height)
     if x.size and (x.min() < 0 or x.max() >= gw or y.min() < 0 or y.max() >= gh):
         raise ValueError(f"x must fit {int_bits(cal.width)} bits and y {int_bits(cal.height)} bits")
+    frac = resolve_frac(cal, frac)
     nb = coord_bits(cal, frac)
     lim_x, lim_y = _limits(cal)
     coord = np.zeros(x.shape, dtype=np.int64)

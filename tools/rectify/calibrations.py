@@ -24,9 +24,10 @@ into such a document (checked by :func:`~eyestereo.tools.rectify.ffc.read_quanti
 a path
     Any ``quantizers.json`` (e.g. written by ``eyestereo rectifier``).
 
-The documents built here carry two keys beyond the FFC's schema: ``source_width``/``source_height``, the
+The documents built here carry keys beyond the FFC's schema: ``source_width``/``source_height``, the
 size of the camera images the maps point into (the range checks of the hardware compare against it;
-for a file without them the rectified size is used), and ``origin`` (the spec).
+for a file without them the rectified size is used), ``origin`` (the spec) and ``float_polynomials``
+(the fitted polynomials before the conversion, for error studies).
 
 Built documents are cached as JSON under ``build/cache/quantizers/`` of the repository (or
 ``$EYESTEREO_CACHE``, else ``~/.cache/eyestereo``), keyed by the spec, the generator version and a hash
@@ -59,7 +60,7 @@ __all__ = ["DEFAULT_SPEC", "cache_dir", "load", "seeded_rig", "shared_data_dir"]
 
 DEFAULT_SPEC = "rig"
 #: Bump when a generator below changes what it builds (invalidates the cache).
-GENERATOR_VERSION = 1
+GENERATOR_VERSION = 2
 _ROOT = Path(__file__).resolve().parents[2]
 
 
@@ -210,7 +211,7 @@ def _build(spec: str, kind: str, args: dict[str, Any]) -> dict[str, Any]:
             pass  # a damaged cache entry is rebuilt
     result = run_ffc(polys, w, h)
     doc = quantizers_dict(result)
-    doc.update(source_width=int(sw), source_height=int(sh), origin=spec)
+    doc.update(source_width=int(sw), source_height=int(sh), origin=spec, float_polynomials=polys)
     folder.mkdir(parents=True, exist_ok=True)
     atomic_write_text(path, dumps_json(doc) + "\n")
     return read_quantizers_json(path)
