@@ -21,7 +21,9 @@ from eyestereo.hdl.convert import convert
 #: Thesis Tables 6.1/6.3 (Xilinx ISE, Spartan-3E 500): LUTs, block RAMs, multipliers.
 THESIS = {"sobel": (259, 2, 0), "harris_window": (843, 4, 3), "cornerness": (132, 0, 5),
           "prethreshold": (197, 0, 0), "prethreshold 1x1": (20, 0, 0), "nms": (381, 2, 0),
-          "nms 5x5": (706, 4, 0), "nms 1x1": (7, 0, 0)}
+          "nms 5x5": (706, 4, 0), "nms 1x1": (7, 0, 0),
+          # Table 4.4 (rectification): the calculation unit; the warper row adds its 99 LUTs to the unit's
+          "poly_unit": (262, 0, 9), "coordinate_warper": (361, 0, 9)}
 
 #: Configurations beyond each block's default that the report also synthesizes: (label, block, params).
 VARIANTS = [

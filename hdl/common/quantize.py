@@ -88,15 +88,6 @@ def q_shift(src, out, k: int):
 
 
 @block
-def q_zero(out):
-    @always_comb
-    def comb():
-        out.next = 0
-
-    return comb
-
-
-@block
 def q_mul(a, b, p):
     @always_comb
     def comb():
@@ -135,9 +126,9 @@ def cut_exact(exact, fl: int, out, fo: Fmt):
     d = fo.fl - fl
     n = len(exact)
     if d >= 0:
-        take = fo.wl - d  # low bits of exact that land in the output; d zero bits below them
-        if take <= 0:
-            return q_zero(out)
+        # The output is the low fo.wl bits of exact << d: the low ``take`` bits of exact above d zeros
+        # (take <= 0: all zeros; one bit is still taken so that every signal has a driver with inputs).
+        take = max(fo.wl - d, 1)
         src = exact
         if n < take:  # the output reaches above the exact value: extend it first
             src = _signed_sig(take) if _is_signed(exact) else Signal(intbv(0)[take:])
@@ -146,14 +137,12 @@ def cut_exact(exact, fl: int, out, fo: Fmt):
             insts.append(q_slice(src, out, take, 0))
             return insts
         low = Signal(intbv(0)[take:])
-        wide = Signal(intbv(0)[fo.wl:])
-        insts += [q_slice(src, low, take, 0), q_shift(low, wide, d), assign(wide, out)]
+        wide = Signal(intbv(0)[take + d:])
+        insts += [q_slice(src, low, take, 0), q_shift(low, wide, d), q_slice(wide, out, fo.wl, 0)]
         return insts
     s = -d  # floor drops s bits; wrap keeps fo.wl bits above them
-    if not _is_signed(exact) and s >= n:
-        return q_zero(out)
     src = exact
-    if n < s + fo.wl:
+    if n < s + fo.wl:  # bits above the exact value: its sign (or zero) extension
         src = _signed_sig(s + fo.wl) if _is_signed(exact) else Signal(intbv(0)[s + fo.wl:])
         insts.append(assign(exact, src))
     insts.append(q_slice(src, out, s + fo.wl, s))

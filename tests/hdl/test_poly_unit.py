@@ -41,3 +41,31 @@ def test_poly_unit_register_coefficients_random_codes(request):
 def test_poly_unit_source_size_overrides(request):
     # a 40x20 rectified image into 64x48 camera images: other range limits, narrower coord port
     _run(request, dict(quantizers="seed:5@40x20", frac=4, source_width=64, source_height=48), cycles=800, seed=5)
+
+
+def random_quantizers(path, seed: int, width: int = 40, height: int = 20) -> None:
+    """A quantizers.json with random formats (every shift and wrap case of the quantizers, q25/q26 not
+    exact) and random codes: the unit must follow any document the toolbox could write."""
+    import json
+
+    import numpy as np
+
+    from eyestereo.tools.fixed import Fmt
+    from eyestereo.tools.rectify.ffc import POLY_NAMES, QUANTIZER_EXPR
+
+    rng = np.random.default_rng(seed)
+    fmts = [Fmt(bool(rng.integers(0, 2)), int(rng.integers(2, 19)), int(rng.integers(-3, 25))) for _ in range(24)]
+    fmts += [Fmt(False, int(rng.integers(3, 9)), int(rng.integers(-1, 3))) for _ in range(2)]
+    doc = {"format": "eyestereo-quantizers", "version": 1, "width": width, "height": height, "degree": 3,
+           "source_width": 64, "source_height": 48,
+           "quantizers": [{"name": f"q{i}", "signed": f.signed, "wl": f.wl, "fl": f.fl, "expr": QUANTIZER_EXPR[i]}
+                          for i, f in enumerate(fmts, 1)],
+           "polynomials": {n: {"codes": [int(rng.integers(f.lo, f.hi + 1)) for f in fmts[:10]]} for n in POLY_NAMES}}
+    path.write_text(json.dumps(doc))
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_poly_unit_any_quantizers_json(request, tmp_path, seed):
+    path = tmp_path / f"random{seed}.quantizers.json"
+    random_quantizers(path, seed)
+    _run(request, dict(quantizers=str(path), frac=seed + 2), cycles=1000, seed=seed, en_p=0.9)
