@@ -54,11 +54,18 @@ demo: setup
 synth: setup
 	$(PY) -m eyestereo.hdl.synth --out build/synth
 
+# The report scripts take their inputs and outputs as arguments; real data beyond tests/data comes
+# from SHARED (a missing data set is left out of the report and said so).
+SHARED ?= ../shared/data
+
 bench: setup
 	$(PY) -m eyestereo.sim.benchmark --out docs/benchmarks.md
-	$(PY) -m eyestereo.tools.reports.harris_report --out docs/harris.md
-	$(PY) -m eyestereo.tools.reports.bench_ffc
-	$(PY) -m eyestereo.tools.reports.bench_matching --out docs/matching.md
+	$(PY) -m eyestereo.tools.reports.harris_report --out docs/harris.md \
+	  --image Tsukuba=tests/data/tsukuba_im3.png --image "chessboard left01=tests/data/chessboard_left01.jpg" \
+	  --image Venus=$(SHARED)/middlebury/venus/im2.png
+	$(PY) -m eyestereo.tools.reports.bench_ffc --out docs/ffc.md
+	$(PY) -m eyestereo.tools.reports.bench_matching --middlebury $(SHARED)/middlebury --out docs/matching.md \
+	  --img docs/img
 
 clean:
 	rm -rf build .pytest_cache .hypothesis

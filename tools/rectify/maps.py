@@ -58,7 +58,8 @@ from typing import TYPE_CHECKING, Any
 import cv2
 import numpy as np
 
-from eyestereo.tools.rectify.calib import StereoCalibration, atomic_output
+from eyestereo.tools.io import atomic_output
+from eyestereo.tools.rectify.calib import StereoCalibration
 
 if TYPE_CHECKING:
     from eyestereo.tools.rectify.rig import StereoRig
