@@ -59,6 +59,7 @@ TMP_MARK = ".eyestereo-"  # in every temporary name, so a leftover is recognisab
 # temporary path -> the user's path; error messages are rewritten with it (see user_text)
 _TEMPS: dict[str, str] = {}
 _TEMPS_LOCK = threading.Lock()
+_TEMPS_KEPT = 512
 
 
 def _umask() -> int:
@@ -91,11 +92,13 @@ def _folder_of(target: Path) -> Path:
 def _remember(tmp: Path, target: Path) -> None:
     with _TEMPS_LOCK:
         _TEMPS[str(tmp)] = str(target)
+        while len(_TEMPS) > _TEMPS_KEPT:  # the oldest go; an error is reported right after its cleanup
+            _TEMPS.pop(next(iter(_TEMPS)))
 
 
 def _forget(tmp: Path) -> None:
-    with _TEMPS_LOCK:
-        _TEMPS.pop(str(tmp), None)
+    """Nothing to do: a temporary is remembered after its removal, so the error that removed it can
+    still be told in the user's terms (:func:`user_text`); the registry keeps the last few hundred."""
 
 
 def user_text(text: str) -> str:
@@ -399,20 +402,21 @@ _CORRUPT = re.compile(r"corrupt|premature end|bad huffman|invalid|unexpected|tru
                       re.IGNORECASE)
 
 
-def check_image_bytes(data: bytes, name: str) -> None:
+def check_image_bytes(data: bytes, name: str, what: str = "image") -> None:
     """ValueError (naming ``name``) if ``data`` is an empty, truncated or corrupt PNG or JPEG file.
 
     PNG: the signature, every chunk's length and CRC, IHDR first, IEND last, and the IDAT stream
     must decompress to its end. JPEG: SOI first, an EOI marker after the last scan. Other formats pass
     (the decoder judges them).
     """
+    name = f"{what} {name}"
     if len(data) == 0:
-        raise ValueError(f"image {name} is an empty file")
+        raise ValueError(f"{name} is an empty file")
     if data.startswith(_PNG_SIG):
         _check_png(data, name)
     elif data.startswith(b"\xff\xd8"):
         if b"\xff\xd9" not in data[2:] or data.rfind(b"\xff\xd9") < data.rfind(b"\xff\xda"):
-            raise ValueError(f"image {name} is a truncated JPEG file (no end-of-image marker after the "
+            raise ValueError(f"{name} is a truncated JPEG file (no end-of-image marker after the "
                              "last scan)")
 
 
@@ -422,34 +426,34 @@ def _check_png(data: bytes, name: str) -> None:
     idat_done = False
     while pos < len(data):
         if len(data) - pos < 12:
-            raise ValueError(f"image {name} is a truncated PNG file")
+            raise ValueError(f"{name} is a truncated PNG file")
         length, ctype = struct.unpack(">I4s", data[pos:pos + 8])
         end = pos + 12 + length
         if end > len(data):
-            raise ValueError(f"image {name} is a truncated PNG file (chunk {ctype.decode('latin-1')!r} "
+            raise ValueError(f"{name} is a truncated PNG file (chunk {ctype.decode('latin-1')!r} "
                              "is cut off)")
         body = data[pos + 8:pos + 8 + length]
         (crc,) = struct.unpack(">I", data[pos + 8 + length:end])
         if zlib.crc32(ctype + body) & 0xFFFFFFFF != crc:
-            raise ValueError(f"image {name} is a corrupt PNG file (CRC error in chunk "
+            raise ValueError(f"{name} is a corrupt PNG file (CRC error in chunk "
                              f"{ctype.decode('latin-1')!r})")
         if first and ctype != b"IHDR":
-            raise ValueError(f"image {name} is a corrupt PNG file (no IHDR chunk first)")
+            raise ValueError(f"{name} is a corrupt PNG file (no IHDR chunk first)")
         first = False
         if ctype == b"IDAT":
             try:
                 z.decompress(body, 0)  # output discarded: only the stream's integrity matters here
             except zlib.error:
-                raise ValueError(f"image {name} is a corrupt PNG file (bad compressed data)") from None
+                raise ValueError(f"{name} is a corrupt PNG file (bad compressed data)") from None
             idat_done = z.eof
         if ctype == b"IEND":
             seen_end = True
             break
         pos = end
     if not seen_end:
-        raise ValueError(f"image {name} is a truncated PNG file (no IEND chunk)")
+        raise ValueError(f"{name} is a truncated PNG file (no IEND chunk)")
     if not idat_done:
-        raise ValueError(f"image {name} is a corrupt PNG file (its compressed pixel data ends early)")
+        raise ValueError(f"{name} is a corrupt PNG file (its compressed pixel data ends early)")
 
 
 @contextlib.contextmanager
@@ -495,7 +499,7 @@ def read_image(path: str | os.PathLike[str], *, what: str = "image") -> np.ndarr
         data = p.read_bytes()
     except OSError as e:
         raise ValueError(_os_message(e, p, "read")) from None
-    check_image_bytes(data, str(p))
+    check_image_bytes(data, str(p), what)
     with _captured_stderr() as said:
         try:
             img = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED)

@@ -154,8 +154,8 @@ def test_user_text_names_the_target(tmp_path):
     out = IO.Outputs()
     tmp = out.file(tmp_path / "calib.yml")
     assert IO.user_text(f"cannot open {tmp} for writing") == f"cannot open {tmp_path / 'calib.yml'} for writing"
-    out.discard()
-    assert IO.user_text(str(tmp)) == str(tmp)  # forgotten once discarded
+    out.discard()  # still known: the error that discarded it is reported afterwards
+    assert IO.user_text(f"{tmp}: No space left") == f"{tmp_path / 'calib.yml'}: No space left"
 
 
 # --------------------------------------------------------------------------------------------------

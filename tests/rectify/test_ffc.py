@@ -595,7 +595,7 @@ def test_cli_ffc_bad_input(tmp_path, capsys, case):
     code, stdout, err = run_cli(["ffc", src, "-o", out, *extra], capsys)
     assert code != 0
     assert err.startswith("eyestereo: error: ") and err.count("\n") == 1
-    assert {"missing": "no such file", "badjson": "not valid JSON", "degree2": "degree 2",
+    assert {"missing": "does not exist", "badjson": "not valid JSON", "degree2": "degree 2",
             "unreachable": "cannot be met", "nodir": "cannot write"}[case] in err
     assert not out.exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ([] if case == "missing" else ["poly.json"])

@@ -172,7 +172,7 @@ def test_cli_package(qjson, tmp_path, capsys):
 
 
 @pytest.mark.parametrize("case, message", [
-    ("missing", "no such file"),
+    ("missing", "does not exist"),
     ("badjson", "not valid JSON"),
     ("count", "must list 26 formats"),
     ("order", "entry 3 must be named 'q3'"),

@@ -61,9 +61,11 @@ __all__ = [
     "number",
     "positive",
     "print_error",
+    "print_note",
     "quiet_libraries",
     "run_command",
     "size",
+    "square",
     "window",
 ]
 
@@ -124,6 +126,16 @@ def integer(lo: int | None = None, hi: int | None = None, what: str = "value") -
     return parse
 
 
+def square(text: str) -> float:
+    """A chessboard square size, 1e-6 .. 1e6 in any unit."""
+    from eyestereo.tools.rectify.calib import SQUARE_RANGE
+
+    v = positive(text)
+    if not SQUARE_RANGE[0] <= v <= SQUARE_RANGE[1]:
+        raise _type_error(f"must lie in {SQUARE_RANGE[0]:g} .. {SQUARE_RANGE[1]:g} (any unit), got {text!r}")
+    return v
+
+
 def positive(text: str) -> float:
     """A finite number > 0."""
     try:
@@ -158,11 +170,14 @@ def nonneg_bits(text: str) -> int:
 
 
 def size(text: str) -> tuple[int, int]:
-    """``WxH``, 1..16384 pixels per side."""
+    """``WxH``, 1..16384 pixels per side, at most 2**24 pixels."""
     m = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", text)
     if m is None or not (1 <= int(m.group(1)) <= 16384 and 1 <= int(m.group(2)) <= 16384):
         raise _type_error(f"size must be WxH with 1..16384 pixels per side, e.g. 352x288; got {text!r}")
-    return int(m.group(1)), int(m.group(2))
+    w, h = int(m.group(1)), int(m.group(2))
+    if w * h > 1 << 24:
+        raise _type_error(f"size {w}x{h} has {w * h} pixels; at most {1 << 24} (e.g. 4096x4096)")
+    return w, h
 
 
 def board(text: str) -> tuple[int, int]:
@@ -251,7 +266,12 @@ def run_command(parser: argparse.ArgumentParser, argv: Sequence[str] | None) -> 
     """Parse ``argv`` with ``parser``, run the chosen handler, return the exit status (never raises
     for bad input; see the module docstring for the codes and the one-line errors)."""
     try:
-        args = parser.parse_args(None if argv is None else [str(a) for a in argv])
+        args, extra = parser.parse_known_args(None if argv is None else [str(a) for a in argv])
+        if extra:  # a command may explain the usual cause (``usage_hint`` in its defaults)
+            text = " ".join(extra)
+            text = text if len(text) <= 120 else text[:117] + "..."
+            hint = getattr(args, "usage_hint", "")
+            parser.error(f"unrecognized arguments: {text}" + (f" ({hint})" if hint else ""))
     except SystemExit as e:  # --help, or a usage error already printed in one line
         return e.code if isinstance(e.code, int) else (EXIT_OK if e.code is None else EXIT_USAGE)
     old_handlers: dict[int, Any] = {}

@@ -21,7 +21,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from eyestereo.tools.cli.common import board, count, nonneg_bits, positive, print_note, size
+from eyestereo.tools.cli.common import board, count, integer, nonneg_bits, positive, print_note, size, square
 from eyestereo.tools.io import Outputs
 
 __all__ = ["register"]
@@ -134,11 +134,11 @@ def cmd_warp(args: argparse.Namespace) -> int:
     from eyestereo.tools.rectify.warp import warp_side
 
     ext = Path(args.output).suffix.lower()
-    if ext not in WARP_FORMATS:
-        raise ValueError(f"cannot write an image of type {ext or '(none)'!r}; use one of "
-                         f"{', '.join(sorted(WARP_FORMATS))}")
     with Outputs() as out:
         tmp = out.file(args.output)
+        if ext not in WARP_FORMATS:
+            raise ValueError(f"cannot write an image of type {ext or '(none)'!r}; use one of "
+                             f"{', '.join(sorted(WARP_FORMATS))}")
         img = read_image(args.image)
         if img.dtype.name not in ("uint8", "uint16"):
             kind = "floating-point" if img.dtype.kind == "f" else img.dtype.name
@@ -211,11 +211,12 @@ def register(sub: Any) -> None:
     p.add_argument("left", metavar="LEFT_GLOB", help="left images, e.g. 'left*.jpg' (quote it)")
     p.add_argument("right", metavar="RIGHT_GLOB", help="right images, paired with the left ones in sorted order")
     p.add_argument("--board", type=board, default=(9, 6), help="inner corners COLSxROWS (default 9x6)")
-    p.add_argument("--square", type=positive, default=0.025, help="square size, the unit of T (default 0.025)")
+    p.add_argument("--square", type=square, default=0.025, help="square size, the unit of T (default 0.025)")
     p.add_argument("--fix-intrinsics", action="store_true",
                    help="keep the per-camera intrinsics in the stereo step (default: refine them jointly)")
     p.add_argument("-o", "--output", required=True, help="calibration file to write (.yml)")
-    p.set_defaults(func=cmd_calibrate)
+    p.set_defaults(func=cmd_calibrate, usage_hint="quote the globs, e.g. 'left*.jpg', so the shell does not "
+                   "expand them")
 
     p = sub.add_parser("maps", help="backward rectification maps from a calibration -> maps.npz")
     p.add_argument("calib", metavar="CALIB", help="calibration file (.yml)")
@@ -254,7 +255,8 @@ def register(sub: Any) -> None:
 
     p = sub.add_parser("rig", help="synthetic EyeBot-like rig: rendered chessboard pairs + true calibration")
     p.add_argument("--views", type=count, default=10, help="number of stereo views (default 10)")
-    p.add_argument("--seed", type=int, default=0, help="random seed of the board poses (default 0)")
+    p.add_argument("--seed", type=integer(0, 2**32 - 1, "--seed"), default=0,
+                   help="random seed of the board poses, 0..2^32-1 (default 0)")
     p.add_argument("--layout", choices=("random", "cover"), default="random",
                    help="board poses: random, near the image centre (default), or cover, spread over the "
                         "whole field of view (use about 27 views)")

@@ -61,6 +61,8 @@ DIST_LENGTHS = (4, 5, 8, 12, 14)
 #: focal length as a multiple of the image side (a field of view of 170 .. 0.1 degrees); distortion
 #: coefficients; baseline (units of the square size); reprojection error (px).
 MAX_IMAGE_SIDE = 16384
+#: The square size a calibration accepts (any unit: 1e-6 .. 1e6 keeps OpenCV's arithmetic sound).
+SQUARE_RANGE = (1e-6, 1e6)
 FOCAL_RANGE = (1 / (2 * np.tan(np.radians(85))), 1 / (2 * np.tan(np.radians(0.05))))
 MAX_DISTORTION = 1e4
 MAX_BASELINE = 1e6
@@ -316,13 +318,14 @@ def _read_node(node: Any, key: str, p: Path) -> Any:
 
 
 def parse_board(text: str) -> tuple[int, int]:
-    """``"9x6"`` -> ``(9, 6)``: inner corners per row and per column, each at least 2."""
+    """``"9x6"`` -> ``(9, 6)``: inner corners per row and per column, each 3..100 (OpenCV's finder needs
+    more than 2)."""
     m = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", str(text))
     if m is None:
         raise ValueError(f"board must be COLSxROWS inner corners, e.g. 9x6; got {text!r}")
     cols, rows = int(m.group(1)), int(m.group(2))
-    if cols < 2 or rows < 2 or cols > 100 or rows > 100:
-        raise ValueError(f"board needs 2..100 inner corners per side, got {cols}x{rows}")
+    if cols < 3 or rows < 3 or cols > 100 or rows > 100:
+        raise ValueError(f"board needs 3..100 inner corners per side, got {cols}x{rows}")
     if cols == rows:
         raise ValueError(f"a square board ({cols}x{rows}) has an ambiguous orientation; use e.g. 9x6")
     return cols, rows
@@ -331,8 +334,8 @@ def parse_board(text: str) -> tuple[int, int]:
 def board_object_points(board: tuple[int, int], square: float) -> np.ndarray:
     """The board's inner corners in its own frame (z = 0), in OpenCV's row-major corner order."""
     cols, rows = board
-    if not square > 0:
-        raise ValueError(f"square size must be > 0, got {square}")
+    if not SQUARE_RANGE[0] <= square <= SQUARE_RANGE[1]:
+        raise ValueError(f"square size must lie in {SQUARE_RANGE[0]:g} .. {SQUARE_RANGE[1]:g} (any unit), got {square}")
     obj = np.zeros((rows * cols, 3), np.float32)
     obj[:, :2] = np.mgrid[0:cols, 0:rows].T.reshape(-1, 2) * square
     return obj
@@ -550,8 +553,12 @@ def calibrate_stereo(left: str | Sequence[Any], right: str | Sequence[Any], *,
     rms1, m1, d1, _, tv1, sd1 = _calibrate_one(objpoints, pts_l, size)
     rms2, m2, d2, _, _, sd2 = _calibrate_one(objpoints, pts_r, size)
     flags = cv2.CALIB_USE_INTRINSIC_GUESS if refine else cv2.CALIB_FIX_INTRINSIC
-    rms, m1, d1, m2, d2, r, t, _, _ = cv2.stereoCalibrate(
-        objpoints, pts_l, pts_r, m1, d1, m2, d2, size, flags=flags, criteria=_CALIB_CRITERIA)
+    try:
+        rms, m1, d1, m2, d2, r, t, _, _ = cv2.stereoCalibrate(
+            objpoints, pts_l, pts_r, m1, d1, m2, d2, size, flags=flags, criteria=_CALIB_CRITERIA)
+    except cv2.error as e:
+        raise ValueError(f"the stereo calibration failed ({_cv_reason(e)}): use more views, with the board in "
+                         "different positions and angles") from None
     if not np.isfinite(rms):
         raise ValueError("stereo calibration did not converge")
     try:
@@ -570,10 +577,19 @@ def calibrate_stereo(left: str | Sequence[Any], right: str | Sequence[Any], *,
     return calib
 
 
+def _cv_reason(e: Exception) -> str:
+    """What an OpenCV exception of the calibration means to the user (its assertion text would not help)."""
+    return "OpenCV found the views degenerate"
+
+
 def _calibrate_one(objpoints: list[np.ndarray], points: list[np.ndarray], size: tuple[int, int]) -> tuple:
     """One camera: (rms, M, D, rvecs, tvecs, standard deviations of fx, fy, cx, cy, k1, ...)."""
-    rms, m, d, rv, tv, sd, _, _ = cv2.calibrateCameraExtended(objpoints, points, size, None, None,
-                                                               criteria=_CALIB_CRITERIA)
+    try:
+        rms, m, d, rv, tv, sd, _, _ = cv2.calibrateCameraExtended(objpoints, points, size, None, None,
+                                                                   criteria=_CALIB_CRITERIA)
+    except cv2.error as e:
+        raise ValueError(f"the calibration failed ({_cv_reason(e)}): use more views, with the board in "
+                         "different positions and angles") from None
     sd = np.asarray(sd, np.float64).ravel()
     sd = np.where(np.isfinite(sd), sd, np.inf)
     return rms, m, d, rv, tv, sd

@@ -179,7 +179,13 @@ class PolyFile:
 
 #: Largest image side the conversion accepts (the maps' limit), and the largest |fl| of a quantizer.
 MAX_SIDE = 16384
+MAX_PIXELS = 1 << 24
 MAX_FRACTION_BITS = 256
+
+
+def _check_pixels(width: int, height: int) -> None:
+    if width * height > MAX_PIXELS:
+        raise FFCError(f"{width}x{height} has {width * height} pixels; at most {MAX_PIXELS} (e.g. 4096x4096)")
 
 
 def _check_size(name: str, v: Any) -> int:
@@ -211,7 +217,7 @@ def read_poly_json(path: str | os.PathLike[str]) -> PolyFile:
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
-        raise FFCError(f"{path}: no such file") from None
+        raise FFCError(f"file {path} does not exist") from None
     except OSError as exc:
         raise FFCError(f"{path}: cannot read: {exc.strerror or exc}") from None
     try:
@@ -223,8 +229,12 @@ def read_poly_json(path: str | os.PathLike[str]) -> PolyFile:
     for key in ("width", "height", "degree", "polynomials"):
         if key not in data:
             raise FFCError(f"{path}: missing key {key!r}")
-    width = _check_size("width", data["width"])
-    height = _check_size("height", data["height"])
+    try:
+        width = _check_size("width", data["width"])
+        height = _check_size("height", data["height"])
+        _check_pixels(width, height)
+    except FFCError as exc:
+        raise FFCError(f"{path}: {exc}") from None
     if data["degree"] != DEGREE or isinstance(data["degree"], bool):
         raise FFCError(f"{path}: the FFC handles degree-3 polynomials only, got degree {data['degree']!r}")
     if "terms" in data and list(data["terms"]) != list(TERMS):
@@ -1110,7 +1120,7 @@ def read_quantizers_json(path: str | os.PathLike[str]) -> dict[str, Any]:
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
-        raise FFCError(f"{path}: no such file") from None
+        raise FFCError(f"file {path} does not exist") from None
     except OSError as exc:
         raise FFCError(f"{path}: cannot read: {exc.strerror or exc}") from None
     except json.JSONDecodeError as exc:
@@ -1120,8 +1130,10 @@ def read_quantizers_json(path: str | os.PathLike[str]) -> dict[str, Any]:
     for key in ("width", "height", "degree", "quantizers", "polynomials"):
         if key not in doc:
             raise FFCError(f"{path}: missing key {key!r}")
-    _check_size("width", doc["width"])
-    _check_size("height", doc["height"])
+    try:
+        _check_pixels(_check_size("width", doc["width"]), _check_size("height", doc["height"]))
+    except FFCError as exc:
+        raise FFCError(f"{path}: {exc}") from None
     if doc["degree"] != DEGREE:
         raise FFCError(f"{path}: degree must be {DEGREE}, got {doc['degree']!r}")
     qs = doc["quantizers"]

@@ -266,6 +266,8 @@ def poly_from_dict(doc: Any, name: str = "poly.json") -> Fit:
             raise ValueError(f"{name}: '{key}' must be a positive integer, got {v!r}")
         if v > 16384:
             raise ValueError(f"{name}: '{key}' {v} is implausible (at most 16384 pixels)")
+    if doc["width"] * doc["height"] > 1 << 24:
+        raise ValueError(f"{name}: {doc['width']}x{doc['height']} is implausible (at most {1 << 24} pixels)")
     degree = doc["degree"]
     if not isinstance(degree, int) or isinstance(degree, bool) or degree not in DEGREES:
         raise ValueError(f"{name}: 'degree' must be 2, 3 or 4, got {degree!r}")
