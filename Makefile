@@ -27,8 +27,10 @@ $(STAMP): pyproject.toml
 	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq python3-venv >/dev/null && \
 	    $(PYTHON) -m venv $(VENV); \
 	  else echo "error: cannot create a venv: install python3-venv (Debian: sudo apt-get install python3-venv)" >&2; exit 1; fi; }
-	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -e '.[dev]'
+	@mkdir -p build
+	@echo "installing eyestereo and its dev extras into $(VENV) (log: build/setup.log) ..."
+	@{ $(PY) -m pip install -q --upgrade pip && $(PY) -m pip install -q -e '.[dev]'; } > build/setup.log 2>&1 || \
+	  { tail -n 30 build/setup.log >&2; echo "error: the installation failed; see build/setup.log" >&2; exit 1; }
 	@rm -f $(VENV)/.installed-*
 	@touch $@
 
