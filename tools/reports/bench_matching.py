@@ -354,7 +354,7 @@ def study_timing(sets) -> list[str]:
 TUNE_ON = ("Tsukuba", "Venus")                 # the scenes the defaults were chosen on
 GOAL_GOOD, GOAL_BAD = 150, 10.0                # the goal on every scene: >= 150 good at <= 10 % bad
 TUNE_BAD = 5.0                                 # the selection rule's bound on the tuning scenes
-TUNE_WINDOWS = (5, 7, 9, 11, 13)
+TUNE_WINDOWS = (5, 7, 9, 11, 13, 15, 17, 19)
 TUNE_NCC = tuple(round(0.6 + 0.05 * i, 2) for i in range(8))  # 0.60 .. 0.95
 
 
@@ -387,19 +387,22 @@ def study_defaults(sets, tuned: dict) -> tuple[list[str], dict]:
     defaults that read the ground truth, and the goal."""
     old = dict(cost="sad", window=(9, 9), t_max=11.0, lr_check=False)
     lines = ["| scene | role | disparities (GT max) | defaults: matches / good / bad (bad %) | RMS px | goal "
-             f">= {GOAL_GOOD} good, <= {GOAL_BAD:g} % bad | old defaults (SAD 9x9 t_max 11, no check, range "
-             "from the GT): good / bad (bad %) |", "|---|---|---:|---:|---:|---|---:|"]
+             f">= {GOAL_GOOD} good, <= {GOAL_BAD:g} % bad | the defaults at the true range (a check only): good / "
+             "bad | old defaults (SAD 9x9 t_max 11, no check, range from the GT): good / bad (bad %) |",
+             "|---|---|---:|---:|---:|---|---:|---:|"]
     out = {}
     for n, s in sets.items():
         r = E.evaluate_pair(s["left"], s["right"], s["gt"], left_xy=s["fl"], right_xy=s["fr"])
         sc = r["scores"]
-        o = run({**s, "d_max": int(math.ceil(s["gt_max"])) + 1}, **old)
+        true_range = int(math.ceil(s["gt_max"])) + 1
+        t = E.evaluate_pair(s["left"], s["right"], s["gt"], left_xy=s["fl"], right_xy=s["fr"], d_max=true_range)
+        o = run({**s, "d_max": true_range}, **old)
         ok = sc.good >= GOAL_GOOD and sc.bad_percent <= GOAL_BAD
         role = "tuned on" if n in tuned["tuned_on"] else "held out"
         out[n] = dict(good=sc.good, bad=sc.bad, bad_percent=sc.bad_percent, ok=ok, role=role)
         lines.append(f"| {n} | {role} | 0..{r['d_max']} ({s['gt_max']:.1f}) | {len(r['matches'])} / {sc.good} / "
                      f"{sc.bad} ({sc.bad_percent:.1f} %) | {sc.rms:.2f} | {'met' if ok else '**not met**'} | "
-                     f"{o['good']} / {o['bad']} ({o['bad_percent']:.1f} %) |")
+                     f"{t['scores'].good} / {t['scores'].bad} | {o['good']} / {o['bad']} ({o['bad_percent']:.1f} %) |")
     return lines, out
 
 
@@ -696,7 +699,8 @@ on the tuning scenes alone, by one rule: NCC with the left-right check and dispa
 among windows {windows} and thresholds {nccs}, the most good matches (summed) with at most
 {tune_bad} % bad on each tuning scene. Each cell below: good (bad %) per tuning scene; struck through:
 the rule's bound is broken; bold: the rule's choice. The rule chose {chosen}; the defaults are
-{agree}. The issue that asked for this reported 12.3 % bad on held-out Middlebury 2003 scenes (Teddy,
+{agree}. The optimum is a plateau: windows 11x11 to 17x17 at NCC 0.70-0.75 lie within a few per
+cent of each other, so the choice among them matters less than the cost function and the check. The issue that asked for this reported 12.3 % bad on held-out Middlebury 2003 scenes (Teddy,
 Cones) with the old defaults; those scenes are not available here, so they are not measured.
 
 {tune}
