@@ -480,13 +480,15 @@ def _captured_stderr() -> Iterator[list[str]]:
             out.append(f.read().decode("utf-8", "replace"))
 
 
-def read_image(path: str | os.PathLike[str], *, what: str = "image") -> np.ndarray:
+def read_image(path: str | os.PathLike[str], *, what: str = "image", grey: bool = False) -> np.ndarray:
     """Read an image file as it is stored (``cv2.IMREAD_UNCHANGED``: grey (H, W), colour (H, W, 3/4)
     in BGR(A) order, any depth), refusing damaged files.
 
-    ValueError (one line, naming the file and calling it ``what``) when the file is missing, a folder,
-    unreadable, empty, a truncated or corrupt PNG/JPEG, or nothing OpenCV can decode. The decoders'
-    own messages never reach the terminal.
+    ``grey=True``: a 2-D image in the file's depth; an 8-bit colour file is converted by its decoder
+    exactly as ``cv2.imread(path, cv2.IMREAD_GRAYSCALE)`` does (what the benches and tests use), a
+    16-bit one by ``cv2.cvtColor``. ValueError (one line, naming the file and calling it ``what``) when
+    the file is missing, a folder, unreadable, empty, a truncated or corrupt PNG/JPEG, or nothing
+    OpenCV can decode. The decoders' own messages never reach the terminal.
     """
     import cv2
 
@@ -515,6 +517,14 @@ def read_image(path: str | os.PathLike[str], *, what: str = "image") -> np.ndarr
         img = img[:, :, 0]
     if img.ndim not in (2, 3) or (img.ndim == 3 and img.shape[2] not in (3, 4)) or img.size == 0:
         raise ValueError(f"{what} {p} is not a grey or colour image (shape {img.shape})")
+    if grey and img.ndim == 3:
+        if img.dtype == np.uint8:
+            with _captured_stderr():
+                img = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_GRAYSCALE)
+        elif img.dtype == np.uint16:
+            img = cv2.cvtColor(img, cv2.COLOR_BGRA2GRAY if img.shape[2] == 4 else cv2.COLOR_BGR2GRAY)
+        else:
+            img = img[..., :3].mean(axis=2).astype(img.dtype)  # refused by to_grey8 anyway
     return img
 
 

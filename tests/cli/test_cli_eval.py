@@ -76,8 +76,8 @@ def test_evaluate_tsukuba_end_to_end(tmp_path, capsys):
     assert doc["good"] + doc["bad"] == doc["evaluated"] and doc["matches"] >= doc["evaluated"] > 200
     assert doc["bad_percent"] == pytest.approx(100 * doc["bad"] / doc["evaluated"], abs=1e-4)
     assert doc["bad_percent"] < 10 and doc["rms"] < 1.5
-    assert doc["params"]["d_max"] == 384 // 4 and doc["params"]["window"] == [17, 17]
-    assert doc["params"]["ncc_min"] == 0.70 and doc["good"] >= 150
+    assert doc["params"]["d_max"] == 384 // 4 and doc["params"]["window"] == [11, 11]
+    assert doc["params"]["ncc_min"] == 0.75 and doc["good"] >= 150
     assert doc["dense"]["evaluated"] > 80000 and doc["dense"]["bad_percent"] > doc["bad_percent"]
     for name in ("matches.png", "disparity.png", "dense.png"):
         img = cv2.imread(str(o / name))
@@ -106,8 +106,8 @@ def test_register_adds_both_commands():
     parser = argparse.ArgumentParser(prog="eyestereo")
     E.register(parser.add_subparsers(dest="command", required=True))
     a = parser.parse_args(["evaluate", "l.png", "r.png", "gt.pgm", "--scale", "16", "--json", "x.json"])
-    assert a.func is E.cmd_evaluate and a.scale == 16 and a.window == (17, 17) and a.t_max == 11
-    assert a.cost == "ncc" and a.ncc_min == 0.70 and a.lr_check is True and a.max_disparity is None
+    assert a.func is E.cmd_evaluate and a.scale == 16 and a.window == (11, 11) and a.t_max == 11
+    assert a.cost == "ncc" and a.ncc_min == 0.75 and a.lr_check is True and a.max_disparity is None
     b = parser.parse_args(["sweep", "l", "r", "g", "--vary", "split", "--values", "1,9", "--window", "5x7",
                            "--no-lr-check"])
     assert b.func is E.cmd_sweep and b.window == (5, 7) and b.lr_check is False

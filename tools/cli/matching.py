@@ -10,7 +10,7 @@ GT is a disparity map of the left view: an 8/16-bit PGM/PNG holding disparity x 
 16 for Tsukuba, 8 for Venus), 0 = unknown; or a PFM/.npy of float disparities (0, NaN, inf = unknown).
 The ground truth only scores the result: the matcher's parameters come from the command line or from
 the images (:mod:`eyestereo.tools.matching.evaluate`: corners from the bit-true Harris model with one
-threshold code for both images, about ``--corners`` in the left one; NCC 17x17 >= 0.70 with the
+threshold code for both images, about ``--corners`` in the left one; NCC 11x11 >= 0.75 with the
 left-right check; disparities 0 .. width / 4 unless ``--max-disparity`` says otherwise).
 
 ``evaluate`` prints the figures and, with ``--json``, writes ``matches``, ``good``, ``bad``,
@@ -273,7 +273,7 @@ def _add_common(p: argparse.ArgumentParser) -> None:
     g.add_argument("--k", type=lambda t: number(t, float, 0, 255 / 256, "--k"), default=d["k"],
                    help=f"Harris k (default {d['k']})")
     g.add_argument("--nms", type=int, choices=(1, 3, 5), default=d["nms"], help=f"NMS window (default {d['nms']})")
-    g = p.add_argument_group("matching (defaults: NCC 17x17 >= 0.70, left-right check, disparities 0..width/4)")
+    g = p.add_argument_group("matching (defaults: NCC 11x11 >= 0.75, left-right check, disparities 0..width/4)")
     g.add_argument("--cost", choices=M.COSTS, default=d["cost"], help=f"cost function (default {d['cost']})")
     g.add_argument("--window", type=window, default=d["window"],
                    help=f"window WxH or N, odd (default {d['window'][0]}x{d['window'][1]})")

@@ -7,7 +7,7 @@ anything read from the ground truth.
 
 **Defaults** (:data:`DEFAULTS`, what ``eyestereo evaluate`` uses unless told otherwise): about 500
 Harris corners per image (one threshold code for both, thesis 7.3), normalized cross-correlation over
-17x17 windows accepted at NCC >= 0.70, the left-right consistency check, and disparities
+11x11 windows accepted at NCC >= 0.75, the left-right consistency check, and disparities
 0 .. width / 4. Why these (measured by ``tools/reports/bench_matching.py``, ``docs/matching.md``
 section "Defaults"):
 
@@ -17,8 +17,8 @@ section "Defaults"):
 * *The left-right check* removes a pair unless each corner is the other's best match; it costs
   little and is what makes a wide disparity range safe.
 * *A quarter of the width* covers the usual rigs (Tsukuba uses 4 % of its width, Motorcycle 8 %);
-  with the check on it costs at most two bad matches per scene here against the true range.
-* *17x17 and 0.70* were chosen on Tsukuba and Venus only, by one rule: the most good matches (summed)
+  with the check on, the bad count at width / 4 equals that at the true range on every scene here.
+* *11x11 and 0.75* were chosen on Tsukuba and Venus only, by one rule: the most good matches (summed)
   with at most 5 % bad on each (half the 10 % goal, a margin for unseen scenes), over windows 5..19
   and NCC thresholds 0.60..0.95. Motorcycle was held out of that choice.
 """
@@ -39,7 +39,7 @@ __all__ = ["DEFAULTS", "VARY", "default_d_max", "evaluate_pair", "match_params",
            "summary", "sweep_pair"]
 
 #: The matcher's defaults for a user (``eyestereo evaluate``); see the module docstring.
-DEFAULTS: dict[str, Any] = dict(corners=500, k=0.04, nms=3, cost="ncc", window=(17, 17), ncc_min=0.70, t_max=11.0,
+DEFAULTS: dict[str, Any] = dict(corners=500, k=0.04, nms=3, cost="ncc", window=(11, 11), ncc_min=0.75, t_max=11.0,
                                 split=1, rows=0, lr_check=True, d_range=0.25)
 
 #: Matching parameters ``sweep`` can vary.

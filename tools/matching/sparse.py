@@ -72,13 +72,14 @@ def load_grey(path) -> np.ndarray:
     """Read an image file as 8-bit grey (:func:`eyestereo.tools.io.read_image` and
     :func:`~eyestereo.tools.io.to_grey8`: damaged files refused, colour to grey, 16-bit to its 8 most
     significant used bits, floating point refused); ValueError naming the file otherwise."""
-    return to_grey8(read_image(path), f"image {path}")
+    return to_grey8(read_image(path, grey=True), f"image {path}")
 
 
 def load_pair(left_path, right_path) -> tuple[np.ndarray, np.ndarray]:
     """A stereo pair as 8-bit grey, like :func:`load_grey`; 16-bit images share one shift, so both
     views keep the same scale. ValueError unless both are readable and of the same size."""
-    imgs = [read_image(left_path, what="left image"), read_image(right_path, what="right image")]
+    imgs = [read_image(left_path, what="left image", grey=True),
+            read_image(right_path, what="right image", grey=True)]
     left, right = to_grey8(imgs, [f"left image {left_path}", f"right image {right_path}"])
     return check_pair(left, right)
 

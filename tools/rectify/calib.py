@@ -483,7 +483,7 @@ def _load_gray(item: Any) -> tuple[np.ndarray, str]:
     if isinstance(item, np.ndarray):
         return to_grey8(item, "image <array>"), "<array>"
     name = os.fspath(item)
-    return to_grey8(read_image(name), f"image {name}"), name
+    return to_grey8(read_image(name, grey=True), f"image {name}"), name
 
 
 # --------------------------------------------------------------------------------------------------

@@ -560,6 +560,9 @@ def main(argv=None) -> int:
 
     text = TEMPLATE.format(
         tune="\n".join(l_tune), defaults="\n".join(l_def), chosen=chosen, current=current,
+        near=", ".join(f"{r['window']}x{r['window']} >= {r['ncc_min']:.2f}" for r in r_tune["rows"]
+                       if best is not None and r["ok"] and r is not best and r["good"] >= 0.99 * best["good"])
+        or "no other configuration",
         goal_good=GOAL_GOOD, goal_bad=f"{GOAL_BAD:g}", tune_bad=f"{TUNE_BAD:g}",
         windows=", ".join(f"{w}x{w}" for w in TUNE_WINDOWS), nccs=f"{TUNE_NCC[0]:.2f} .. {TUNE_NCC[-1]:.2f}",
         agree="the same" if agree else "**different: update eyestereo.tools.matching.evaluate.DEFAULTS**",
@@ -699,8 +702,8 @@ on the tuning scenes alone, by one rule: NCC with the left-right check and dispa
 among windows {windows} and thresholds {nccs}, the most good matches (summed) with at most
 {tune_bad} % bad on each tuning scene. Each cell below: good (bad %) per tuning scene; struck through:
 the rule's bound is broken; bold: the rule's choice. The rule chose {chosen}; the defaults are
-{agree}. The optimum is a plateau: windows 11x11 to 17x17 at NCC 0.70-0.75 lie within a few per
-cent of each other, so the choice among them matters less than the cost function and the check. The issue that asked for this reported 12.3 % bad on held-out Middlebury 2003 scenes (Teddy,
+{agree}. The optimum is a plateau: {near} lie within 1 % of the choice's good matches, so the
+choice among them matters less than the cost function and the check. The issue that asked for this reported 12.3 % bad on held-out Middlebury 2003 scenes (Teddy,
 Cones) with the old defaults; those scenes are not available here, so they are not measured.
 
 {tune}

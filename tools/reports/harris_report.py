@@ -33,7 +33,7 @@ W, H = 352, 288
 
 
 def load(path: Path) -> np.ndarray:
-    img = to_grey8(read_image(path), f"image {path}")
+    img = to_grey8(read_image(path, grey=True), f"image {path}")
     if img.shape[0] < H or img.shape[1] < W:
         raise ValueError(f"image {path} is smaller than {W}x{H}")
     y0, x0 = (img.shape[0] - H) // 2, (img.shape[1] - W) // 2
