@@ -5,7 +5,7 @@
     python -m eyestereo.tools.reports.bench_matching --middlebury ../shared/data/middlebury \
         --out docs/matching.md --img docs/img
 
-(``make bench`` passes these) writes the page and its plots ``matching_*.png`` (``--no-write`` only prints):
+(``make bench`` passes these) writes the page and its plots ``matching_*.png`` (``--no-write`` prints the page instead):
 
 * the defaults of ``eyestereo evaluate`` on every scene, how they were chosen (tuned on Tsukuba and
   Venus, Motorcycle held out) and the old defaults that read the ground truth,
