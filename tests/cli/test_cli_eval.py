@@ -150,7 +150,7 @@ def test_runtime_errors_exit_1_and_write_nothing(synthetic, capsys):
         ((L, synthetic / "none.png", G), "does not exist"),
         ((L, R, G, "--threshold", 524287), "no corners"),
         ((L, R, G, "--json", synthetic / "no" / "x.json"), "does not exist"),
-        ((L, R, G, "--cost", "ncc", "--split", "9"), "split correlation is defined for SAD and SSD only"),
+        ((L, R, G, "--cost", "ncc", "--split", "9"), "split correlation is defined for the SAD and SSD costs only"),
     ]
     for args, msg in cases:
         code, out, err = run(capsys, "evaluate", *args, "--json", j) if "--json" not in args else \

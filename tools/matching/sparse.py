@@ -333,7 +333,7 @@ def match_features(left, right, left_xy, right_xy, *, window=(9, 9), t_max: floa
         raise ValueError(f"cost must be one of {COSTS}, got {cost!r}")
     offsets = split_offsets((w, h), split)
     if cost == "ncc" and split != 1:
-        raise ValueError("split correlation is defined for SAD and SSD only")
+        raise ValueError("split correlation is defined for the SAD and SSD costs only, not for NCC")
     if not (np.isfinite(t_max) and t_max > 0):
         raise ValueError(f"t_max must be a positive number, got {t_max}")
     if not -1 <= ncc_min <= 1:

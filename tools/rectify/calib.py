@@ -453,7 +453,12 @@ def find_corners(gray: np.ndarray, board: tuple[int, int], refine: str = "saddle
     if gray.ndim != 2 or gray.dtype != np.uint8:
         raise ValueError(f"find_corners wants a 2-D uint8 grey image, got {gray.dtype} {gray.shape}")
     flags = cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE
-    ok, corners = cv2.findChessboardCorners(gray, board, flags=flags)
+    if min(gray.shape) < 4 * min(board) or max(gray.shape) < 4 * max(board):
+        return None  # too small to hold the board (and OpenCV's finder asserts on tiny images)
+    try:
+        ok, corners = cv2.findChessboardCorners(gray, board, flags=flags)
+    except cv2.error:  # OpenCV refuses some degenerate images outright: no board there
+        return None
     if not ok or corners is None or len(corners) != board[0] * board[1]:
         return None
     grid = corners.reshape(board[1], board[0], 2)

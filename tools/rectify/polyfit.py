@@ -317,6 +317,7 @@ def plot_errors(maps: Maps, result: Fit, folder: str | os.PathLike[str], *, step
         raise ValueError(f"maps are {maps.width}x{maps.height} but the fit is {result.width}x{result.height}")
     written = []
     h, w = maps.height, maps.width
+    step = max(1, min(step, w, h))  # a small map still gets one arrow per cell
     bar = progress_bar(4, "error plots")
     for side in ("left", "right"):
         mx, my = maps.side(side)
