@@ -204,7 +204,8 @@ class Outputs:
     a folder only ours) and return the temporary to write. Leaving the ``with`` block normally
     commits: each target is checked again, then renamed into place (an existing one moved aside and
     deleted only after every rename succeeded; a failure puts every earlier target back). SIGINT and
-    SIGTERM are held back during the renames. An exception in the block discards every temporary.
+    SIGTERM are held back during the renames; should a rename fail, every target renamed before it is put
+back as it was. An exception in the block discards every temporary.
     """
 
     def __init__(self) -> None:
@@ -285,29 +286,32 @@ class Outputs:
                 check_output_folder(t, pred)
                 _normalise_modes(tmp)
                 os.chmod(tmp, dir_mode(t))
-        done: list[tuple[Path, Path | None]] = []  # (target, its old version moved aside)
+        done: list[tuple[Path, Path | None]] = []  # (target, its old version kept aside, or None if new)
         try:
             for t, tmp, kind, _ in self._items:
                 old = None
                 if kind == "folder" and t.is_dir():
                     old = _aside(t)
+                elif kind == "file" and t.exists():
+                    old = _keep_copy(t)
                 try:
                     os.replace(tmp, t) if kind == "file" else os.rename(tmp, t)
                 except OSError as e:
-                    if old is not None:
+                    if old is not None and kind == "folder":
                         os.rename(old, t)
+                    elif old is not None:
+                        old.unlink()
                     raise OSError(e.errno, _os_message(e, t)) from None
                 done.append((t, old))
         except BaseException:
-            # files replaced earlier cannot come back (os.replace drops the old one), folders can
-            for t, old in reversed(done):
+            for t, old in reversed(done):  # put every earlier target back as it was
+                _remove(t)
                 if old is not None:
-                    shutil.rmtree(t, ignore_errors=True)
-                    os.rename(old, t)
+                    os.replace(old, t) if not old.is_dir() else os.rename(old, t)
             raise
         for _, old in done:
             if old is not None:
-                shutil.rmtree(old, ignore_errors=True)
+                _remove(old)
 
     def _check_open(self) -> None:
         if not self._open:
@@ -360,6 +364,19 @@ def _aside(t: Path) -> Path:
     os.rmdir(old)
     os.rename(t, old)
     return old
+
+
+def _keep_copy(t: Path) -> Path:
+    """A hidden second name (a hard link, else a copy) of file ``t``, so a replaced file can come back."""
+    fd, name = tempfile.mkstemp(prefix=f".{t.name}{TMP_MARK}old-", dir=_folder_of(t))
+    os.close(fd)
+    keep = Path(name)
+    try:
+        os.unlink(keep)
+        os.link(t, keep)
+    except OSError:
+        shutil.copy2(t, keep)
+    return keep
 
 
 def _remove(p: Path) -> None:

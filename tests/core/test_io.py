@@ -107,6 +107,27 @@ def test_outputs_commit_everything_or_nothing(tmp_path, umask022):
     assert names(tmp_path / "pics") == ["x.png"]
 
 
+def test_a_failing_rename_puts_the_earlier_targets_back(tmp_path, monkeypatch):
+    (tmp_path / "a.json").write_text("old a")
+    (tmp_path / "pics").mkdir()
+    (tmp_path / "pics" / "x.png").write_text("old x")
+    real_rename = os.rename
+
+    def rename(src, dst):
+        if Path(dst).name == "pics" and ".eyestereo-" in Path(src).name and "old-" not in Path(src).name:
+            raise OSError(5, "Input/output error")
+        return real_rename(src, dst)
+
+    monkeypatch.setattr(os, "rename", rename)
+    with pytest.raises(OSError, match="cannot write .*pics: Input/output error"):
+        with IO.Outputs() as out:
+            out.file(tmp_path / "a.json").write_text("new a")
+            out.file(tmp_path / "b.json").write_text("new b")
+            (out.folder(tmp_path / "pics", {"x.png"}) / "x.png").write_text("new x")
+    assert names(tmp_path) == ["a.json", "pics"] and (tmp_path / "a.json").read_text() == "old a"
+    assert (tmp_path / "pics" / "x.png").read_text() == "old x"
+
+
 def test_an_existing_folder_is_replaced_only_when_it_is_ours(tmp_path):
     run = tmp_path / "run"
     run.mkdir()
