@@ -20,11 +20,13 @@ from eyestereo.hdl.nms import nms
 from eyestereo.hdl.prethreshold import prethreshold
 from eyestereo.hdl.line_delay import line_delay
 from eyestereo.hdl.sobel import sobel
+from eyestereo.hdl.stream_checker import stream_checker
 from eyestereo.hdl.stream import ImageStream
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import harris_window as window_model
 from eyestereo.tools.models import nms as nms_model
 from eyestereo.tools.models import sobel as sobel_model
+from eyestereo.tools.models import stream_checker as checker_model
 from eyestereo.tools.models.convolve import check_kernel, output_width
 
 
@@ -48,17 +50,25 @@ class BlockSpec:
         p.update(overrides)
         return p
 
-    def elaborate(self, **overrides):
-        """(instance, ports dict) of a fresh instance with the given parameters."""
+    def ports(self, **overrides) -> tuple[dict, dict, dict]:
+        """(fresh ports in call order, the block function's keyword parameters, all parameters).
+
+        A ``stereo`` parameter (blocks that take stereo streams have one) makes both streams stereo.
+        """
         p = self.params(**overrides)
-        clk = Signal(bool(0))
-        rst = ResetSignal(0, active=1, isasync=False)
-        sink = ImageStream(self.sink_width(p))
-        source = ImageStream(self.source_width(p))
+        stereo = bool(p.get("stereo", False))
+        ports = dict(clk=Signal(bool(0)), rst=ResetSignal(0, active=1, isasync=False),
+                     sink=ImageStream(self.sink_width(p), stereo=stereo),
+                     source=ImageStream(self.source_width(p), stereo=stereo))
+        ports.update((name, make(p)) for name, make in self.control)
         kw = {k: v for k, v in p.items() if k in self.hw_params}
-        ctrl = {name: make(p) for name, make in self.control}
-        inst = self.func(clk, rst, sink, source, *ctrl.values(), **kw)
-        return inst, dict(clk=clk, rst=rst, sink=sink, source=source, **ctrl), p
+        return ports, kw, p
+
+    def elaborate(self, **overrides):
+        """(instance, ports dict, parameters) of a fresh instance with the given parameters."""
+        ports, kw, p = self.ports(**overrides)
+        inst = self.func(*ports.values(), **kw)
+        return inst, ports, p
 
     def entity(self, **overrides) -> str:
         return self.name
@@ -85,7 +95,7 @@ def _conv_width(p):
 BLOCKS: dict[str, BlockSpec] = {
     "line_delay": BlockSpec(
         "line_delay", "one-line FIFO in block RAM: pixel (x, y-1) at (x, y)", line_delay,
-        dict(width=352, height=288, data_width=8),
+        dict(width=352, height=288, data_width=8, stereo=False),
         sink_width=lambda p: p["data_width"], source_width=lambda p: p["data_width"],
         hw_params=("width", "height")),
     "convolve": BlockSpec(
@@ -122,6 +132,14 @@ BLOCKS: dict[str, BlockSpec] = {
         sink_width=lambda p: 8, source_width=lambda p: nms_model.WORD.width,
         hw_params=("width", "height", "blocks", "nms"),
         control=(("k", _k_port),) + _thr_ports()),
+    "stream_checker": BlockSpec(
+        "stream_checker", "protocol checker: lines/frames of the wrong size, stereo interleaving; sticky error "
+        "and fault code; optional repair (broken frames become reset tokens)", stream_checker,
+        dict(width=352, height=288, data_width=8, stereo=False, repair=False),
+        sink_width=lambda p: p["data_width"], source_width=lambda p: p["data_width"],
+        hw_params=("width", "height", "repair"),
+        control=(("error", lambda p: Signal(bool(0))),
+                 ("code", lambda p: Signal(intbv(0)[checker_model.CODE_BITS:])))),
 }
 
 
