@@ -37,7 +37,7 @@ from myhdl._Signal import _Signal
 from eyestereo.hdl.stream import ImageStream
 
 __all__ = ["check_clock", "check_reset", "check_stream", "check_signal", "check_int", "check_choice",
-           "check_bool", "check_frame", "check_distinct"]
+           "check_bool", "check_frame", "check_distinct", "block_error", "checked"]
 
 #: The largest frame side the blocks' counters are sized for.
 MAX_SIZE = 4096
@@ -54,9 +54,31 @@ def _block_name() -> str | None:
     return None
 
 
-def _fail(msg: str) -> ValueError:
+def block_error(msg: str) -> ValueError:
+    """A ValueError for a check of the block's own, with the block's name in front like the others'::
+
+        raise block_error(f"port sink carries {dw} bits, at most 36 fit one block RAM word")
+    """
     name = _block_name()
     return ValueError(f"{name}: {msg}" if name else msg)
+
+
+_fail = block_error
+
+
+def checked(check, *args, **kwargs):
+    """Run a check written on the model side (``tools/``, which knows nothing of blocks) and put the
+    block's name in front of its ValueError; returns what the check returns::
+
+        blocks = checked(check_blocks, width, height, blocks)
+    """
+    try:
+        return check(*args, **kwargs)
+    except ValueError as e:
+        name = _block_name()
+        if name is None or str(e).startswith(f"{name}: "):
+            raise
+        raise ValueError(f"{name}: {e}") from None
 
 
 def _what(x) -> str:
