@@ -100,6 +100,11 @@ def stream_checker(clk, rst, sink, source, error, code, *, width: int = 352, hei
 
     x = Signal(intbv(0, min=0, max=width))
     y = Signal(intbv(0, min=0, max=height))
+    # x == width-1, y == height-1 as registers of their own: the fault decode then needs no comparator.
+    x_last_0, y_last_0 = width == 1, height == 1
+    x_last = Signal(bool(x_last_0))
+    y_last = Signal(bool(y_last_0))
+    xl, yl = width - 1, height - 1
     phase = Signal(bool(0))  # stereo: the right camera's beat is due
     left_eol = Signal(bool(0))  # stereo: the left beat's flags, which the right beat must repeat
     left_eof = Signal(bool(0))
@@ -142,9 +147,9 @@ def stream_checker(clk, rst, sink, source, error, code, *, width: int = 352, hei
             else:
                 fault.next = geo
 
-        insts = [classify, geometry(sink, x, y, geo, width=width, height=height)]
+        insts = [classify, geometry(sink, x_last, y_last, geo)]
     else:
-        insts = [geometry(sink, x, y, fault, width=width, height=height)]
+        insts = [geometry(sink, x_last, y_last, fault)]
 
     @always_comb
     def status():
@@ -181,20 +186,28 @@ def stream_checker(clk, rst, sink, source, error, code, *, width: int = 352, hei
         if token:
             x.next = 0
             y.next = 0
+            x_last.next = x_last_0
+            y_last.next = y_last_0
             sync.next = True
         elif advance:
             if sink.eol:
                 x.next = 0
+                x_last.next = x_last_0
                 if sink.eof:
                     y.next = 0
+                    y_last.next = y_last_0
                 else:
                     y.next = y + 1
+                    y_last.next = y == yl - 1
             else:
                 x.next = x + 1
+                x_last.next = x == xl - 1
         elif bad:
             if frame_end:
                 x.next = 0
                 y.next = 0
+                x_last.next = x_last_0
+                y_last.next = y_last_0
                 sync.next = True
             else:
                 sync.next = False
@@ -234,21 +247,21 @@ def stream_checker(clk, rst, sink, source, error, code, *, width: int = 352, hei
 
 
 @block
-def geometry(sink, x, y, fault, *, width: int, height: int):
-    """The fault of a pixel beat (of one camera) that should be pixel (x, y) of a width x height frame."""
-    xl, yl = width - 1, height - 1
+def geometry(sink, x_last, y_last, fault):
+    """The fault of a pixel beat (of one camera) at a position that is (x_last) or is not the line's last
+    pixel, on a line that is (y_last) or is not the frame's last."""
     LONG, SHORT, NOEOF, EARLY = model.LONG_LINE, model.SHORT_LINE, model.MISSING_EOF, model.EARLY_EOF
 
     @always_comb
     def classify():
-        if x != xl:
+        if not x_last:
             if sink.eol:
                 fault.next = SHORT
             else:
                 fault.next = 0
         elif not sink.eol:
             fault.next = LONG
-        elif y != yl:
+        elif not y_last:
             if sink.eof:
                 fault.next = EARLY
             else:

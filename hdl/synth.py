@@ -29,6 +29,10 @@ VARIANTS = [
     ("nms 1x1", "nms", dict(size=1)),
     ("nms 5x5", "nms", dict(size=5)),
     ("harris_mono nms 5x5", "harris_mono", dict(nms=5)),
+    ("line_delay stereo", "line_delay", dict(stereo=True)),
+    ("stream_checker repair", "stream_checker", dict(repair=True)),
+    ("stream_checker stereo", "stream_checker", dict(stereo=True)),
+    ("stream_checker stereo repair", "stream_checker", dict(stereo=True, repair=True)),
 ]
 
 

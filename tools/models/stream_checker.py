@@ -162,7 +162,15 @@ def faulty_frame(kind: str, width: int, height: int, rng: np.random.Generator, *
     """
     left = rng.integers(0, 1 << bits, (height, width))
     right = rng.integers(0, 1 << bits, (height, width))
-    beats = frame_beats(left, stereo=stereo, right=right)
+    return inject_fault(frame_beats(left, stereo=stereo, right=right), kind, width, height, rng, stereo=stereo)
+
+
+def inject_fault(beats: list[tuple], kind: str, width: int, height: int, rng: np.random.Generator, *,
+                 stereo: bool = False) -> tuple[list[tuple], int]:
+    """:func:`faulty_frame` for the beats of a given (whole, width x height) frame."""
+    beats = list(beats)
+    if len(beats) != width * height * (2 if stereo else 1):
+        raise ValueError(f"inject_fault needs the beats of one whole {width}x{height} frame, got {len(beats)}")
     n = 2 if stereo else 1  # beats per pixel
     line = width * n
 
