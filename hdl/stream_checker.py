@@ -43,8 +43,9 @@ def stream_checker(clk, rst, sink, source, error, code, *, width: int = 352, hei
     With ``repair=True`` the faulty beat leaves as a reset token (``eof`` high, ``eol`` low) and the
     beats up to the recovery point are dropped, so the source always keeps the protocol: every frame
     is whole or cut short by a reset token, and each block behind recovers at that token (a reset
-    token puts every block back to its start-of-frame state). Without repair a broken frame goes on as it came; the blocks behind turn
-    it into an output frame of unspecified data and recover at the next reset token.
+    token puts every block back to its start-of-frame state). Without repair a broken frame goes on as
+    it came; the blocks behind make output of unspecified data of it and recover at the next reset
+    token (tests/hdl/test_recovery.py).
 
     Ports:
         clk: clock, rising edge.
@@ -61,16 +62,16 @@ def stream_checker(clk, rst, sink, source, error, code, *, width: int = 352, hei
 
     Latency: 1 clock (stream, ``error`` and ``code`` alike).
 
-    Resources: two position counters (log2 width + log2 height bits), their end-of-line/frame
-    comparators, the error and code registers and the output registers; no block RAM, no multiplier
-    (Spartan-3E, Yosys, 352x288 mono: see docs/benchmarks.md and docs/bad_input.md).
+    Resources: two position counters with registered last-pixel / last-line flags, the error and code
+    registers and the output registers; no block RAM, no multiplier. Yosys, Spartan-3E, 352x288, 8-bit
+    data: 41 LUT, 36 FF (repair: 44 LUT; stereo: 54 LUT, 40 FF).
 
     Timing: a 3x2 frame whose second line is one pixel short (code 2, SHORT_LINE), a reset token, and
     the next frame (``#`` high, ``_`` low, ``.`` don't care; the source carries each sink beat one clock
     later)::
 
         cycle         0    1    2    3    4    5    6    7    8    9
-        sink_valid    #    #    #    #    #    _    #    #    #    .
+        sink_valid    #    #    #    #    #    _    #    #    #    _
         sink_eol      _    _    #    _    #    .    _    _    _    .
         sink_eof      _    _    _    _    _    .    #    _    _    .
         sink_data    0,0  1,0  2,0  0,1  1,1   .   tok  0,0  1,0   .

@@ -95,7 +95,9 @@ def _what(x) -> str:
             if len(x) == 0:
                 return "a Signal(intbv) without a bit width"
             kind = "signed" if x.min is not None and x.min < 0 else "unsigned"
-            return f"a {len(x)}-bit {kind} Signal(intbv)"
+            n = len(x)
+            article = "an" if str(n).startswith("8") or n in (11, 18) else "a"
+            return f"{article} {n}-bit {kind} Signal(intbv)"
         return f"a Signal of {type(v).__name__} {v!r}"[:80]
     if isinstance(x, ImageStream):
         return repr(x)

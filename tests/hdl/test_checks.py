@@ -109,7 +109,7 @@ def test_signal_kinds():
         check_signal("k", Signal(3))
     with pytest.raises(ValueError, match=r"port k must be a MyHDL Signal, got an ImageStream"):
         check_signal("k", ImageStream(8))
-    with pytest.raises(ValueError, match=r"port k must be unsigned, got a 8-bit signed Signal\(intbv\)"):
+    with pytest.raises(ValueError, match=r"port k must be unsigned, got an 8-bit signed Signal\(intbv\)"):
         check_signal("k", Signal(intbv(0, min=-128, max=128)), signed=False)
     check_signal("we", Signal(intbv(0)[1:]), width=1)  # a 1-bit intbv is as good as a bool
 

@@ -323,7 +323,7 @@ def test_streams_and_control_ports_swapped(name):
     for port in ("sink", "source"):
         ports, kw, _ = spec.ports(**_small(spec))
         ports[port] = Signal(intbv(0)[8:])
-        _expect(name, rf"port {port} must be an ImageStream, got a 8-bit unsigned Signal", spec, ports, kw)
+        _expect(name, rf"port {port} must be an ImageStream, got an 8-bit unsigned Signal", spec, ports, kw)
     for port, _ in spec.control:
         ports, kw, _ = spec.ports(**_small(spec))
         ports[port] = ImageStream(8)
@@ -360,7 +360,7 @@ def test_control_port_widths_and_kinds(name):
         if n > 1 and port in ("k", "thr_data"):  # code bits: a signed Signal would be read as a number
             ports, kw, _ = spec.ports(**_small(spec))
             ports[port] = Signal(intbv(0, min=-(1 << (n - 1)), max=1 << (n - 1)))
-            _expect(name, rf"port {port} must be unsigned, got a {n}-bit signed", spec, ports, kw)
+            _expect(name, rf"port {port} must be unsigned, got an? {n}-bit signed", spec, ports, kw)
 
 
 @pytest.mark.parametrize("name", sorted(BLOCKS))

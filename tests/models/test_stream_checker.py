@@ -189,3 +189,14 @@ def test_fault_table_is_complete():
         m.faulty_frame("nope", 4, 4, np.random.default_rng(0), stereo=True)
     with pytest.raises(ValueError, match="needs a stereo stream"):
         m.faulty_frame("cam_swap", 4, 4, np.random.default_rng(0))
+
+
+def test_docstring_timing_example():
+    """The timing diagram of hdl/stream_checker.py: a 3x2 frame whose second line is one pixel short."""
+    beats = [(0, 0, 0), (1, 0, 0), (2, 1, 0), (3, 0, 0), (4, 1, 0), TOKEN, (5, 0, 0), (6, 0, 0)]
+    steps = m.stream_checker(beats, 3, 2)
+    assert m.fault_positions(steps) == [(4, m.SHORT_LINE)]
+    assert [(s.error, s.code) for s in steps] == [(False, 0)] * 4 + [(True, 2)] * 4
+    assert m.output_beats(steps) == beats
+    repaired = m.stream_checker(beats, 3, 2, repair=True)
+    assert repaired[4].out == (4, False, True) and m.output_beats(repaired) == beats[:4] + [(4, False, True)] + beats[5:]
