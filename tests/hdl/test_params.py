@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import numbers
+import re
+import warnings
+
 import numpy as np
 import pytest
-from myhdl import ResetSignal, Signal
+from myhdl import ResetSignal, Signal, intbv
 
 from eyestereo.hdl.catalog import BLOCKS, get
 from eyestereo.hdl.convolve import convolve
@@ -244,10 +248,6 @@ def test_catalog_overrides_reach_the_block():
 # make when instantiating a block ends in one ValueError that starts with the block's name and names the
 # port or parameter, never in a MyHDL or Python internal error. New catalogue blocks are covered too.
 
-import numbers  # noqa: E402
-import warnings  # noqa: E402
-
-from myhdl import intbv  # noqa: E402
 
 SMALL_FRAME = dict(width=16, height=8)
 
@@ -273,8 +273,6 @@ def _expect(name, match, spec, ports, kw):
     assert re.search(match, msg), f"{msg!r} does not match {match!r}"
     return msg
 
-
-import re  # noqa: E402
 
 BAD_PORT_VALUES = {
     "None": (lambda ports, n: None, r"got None"),
