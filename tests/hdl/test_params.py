@@ -213,6 +213,8 @@ def test_catalog_default_configuration_elaborates(name):
     inst, ports_, p = spec.elaborate()
     assert inst is not None
     assert p == spec.params()
+    if spec.build is not None:  # multi-clock and camera blocks: their ports are checked in test_camera_params
+        return
     assert set(ports_) == {"clk", "rst", "sink", "source"} | {n for n, _ in spec.control}
     assert len(ports_["sink"].data) == spec.sink_width(spec.params())
     assert len(ports_["source"].data) == spec.source_width(spec.params())
