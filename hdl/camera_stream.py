@@ -35,6 +35,7 @@ def camera_stream(cam, rst, source, luma=None, *, width: int = 352, height: int 
       consumer takes a broken frame for a good one; then the block waits for the next VSYNC;
     * ``eol`` and ``eof`` leave only once HREF has dropped at the right byte: a frame that ends with
       ``eof`` had every line exactly right;
+    * a reset token's data bits are unspecified (they keep the last word's: one mux level less);
     * lines after the frame's last one are ignored until the next VSYNC.
 
     Ports:
@@ -126,7 +127,6 @@ def camera_stream(cam, rst, source, luma=None, *, width: int = 352, height: int 
                 if started:
                     o_valid.next = True
                     o_eof.next = True
-                    o_data.next = 0
             armed.next = True
             started.next = False
             y.next = 0
@@ -138,7 +138,6 @@ def camera_stream(cam, rst, source, luma=None, *, width: int = 352, height: int 
                     if started:
                         o_valid.next = True
                         o_eof.next = True
-                        o_data.next = 0
                     armed.next = False
                     started.next = False
                     n.next = 0
@@ -175,7 +174,6 @@ def camera_stream(cam, rst, source, luma=None, *, width: int = 352, height: int 
                 if started:
                     o_valid.next = True
                     o_eof.next = True
-                    o_data.next = 0
                 armed.next = False
                 started.next = False
             n.next = 0

@@ -11,8 +11,8 @@ nothing after their first sample):
 * HREF inactive after a line: a line of exactly ``2 * width`` bytes ends with its last word, flagged
   ``eol`` (and ``eof`` on the frame's last line; the frame is then complete and the block waits for the
   next VSYNC); any other length aborts the frame (line too short).
-* An aborted frame ends with a reset token (``eof`` without ``eol``) if any of its words came out, and
-  with nothing otherwise. A frame whose VSYNC the block did not see (it came out of reset, or the camera
+* An aborted frame ends with a reset token (``eof`` without ``eol``; its data bits are unspecified, 0
+  here) if any of its words came out, and with nothing otherwise. A frame whose VSYNC the block did not see (it came out of reset, or the camera
   was switched on, after it) is never started: no word of it comes out.
 * Reset (``rst`` high at an edge): the block forgets everything and waits for the next VSYNC.
 
