@@ -125,6 +125,10 @@ async def camera_frames(dut):
                 f"want {want[i] if i < len(want) else None} (edge {s.model.beats[i][3] if i < len(want) else None}); "
                 f"model frames {s.model.frame_ids}, aborted {s.model.aborted}, dropped {s.model.dropped}")
         same_edge = sum(a[3] == b[3] for a, b in zip(mon.beats, s.model.beats))
+        # Latency of each word taken: from the bus sample that completed it (the pair's 4th byte for an
+        # even pixel, the next sample for an odd one) to the read edge that moved it.
+        lat = [rclk.time(b[3]) - s.pclk.time(e.wedge - 2)
+               for b, e in zip(mon.beats, s.model.fifo.out) if not e.token]
         # The delivered frames are the camera's frames (checked against the stimulus, not the model).
         for f, fid in zip(s.model.frames, s.model.frame_ids):
             src = s.frames[fid + s.offset]
@@ -137,5 +141,6 @@ async def camera_frames(dut):
             cut_by_rrst=[[fid + s.offset, n] for fid, n in s.model.cut_off], dropped=dropped,
             edges_equal=same_edge, max_level=s.model.fifo.max_level, lost=s.model.fifo.lost,
             monitor_wakes=mon.wakes, model_seconds=s.model_seconds,
+            latency_ps=[min(lat), max(lat), sum(lat) / len(lat)] if lat else None,
             camera_samples=s.camera.samples))
     write_report(cfg, report)

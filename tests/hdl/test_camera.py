@@ -30,11 +30,44 @@ def ps(mhz: float) -> int:
     return 2 * round(1e6 / mhz / 2)
 
 
-def _run(block, bench, cfg, request, params):
+def _run(block, bench, cfg, request, params, sim=None):
     kw = {}
-    if "harness" in inspect.signature(run_bench).parameters:
+    sig = inspect.signature(run_bench).parameters
+    if "harness" in sig:
         kw["harness"] = False  # multi-clock benches drive their ports themselves
+    if sim is not None:
+        if "sim" not in sig:
+            return _run_icarus(block, bench, cfg, request.node.name, params)
+        kw["sim"] = sim
     return run_bench(block, bench, cfg, name=request.node.name, params=params, **kw)
+
+
+def _run_icarus(block, bench, cfg, name, params):
+    """The Verilog conversion on Icarus, for a runner without ``sim=`` (the same bench, the same checks)."""
+    import json
+    import os
+    import shutil
+
+    from cocotb_tools.runner import get_results, get_runner
+
+    from eyestereo.hdl.convert import convert
+    from eyestereo.sim.runner import BUILD, SIM_DIR, slug
+
+    if shutil.which("iverilog") is None:
+        pytest.skip("Icarus Verilog not installed")
+    d = BUILD / slug(block) / (slug(name) + ".icarus")
+    shutil.rmtree(d, ignore_errors=True)
+    d.mkdir(parents=True)
+    sources = convert(block, d, hdl="Verilog", **params)
+    runner = get_runner("icarus")
+    runner.build(sources=[str(p) for p in sources], hdl_toplevel=block, build_dir=d, always=True,
+                 timescale=("1ns", "1ps"))
+    env = {"EYESTEREO_TB": json.dumps(dict(cfg, block=block, params=params, report=str(d / "report.json"))),
+           "PYTHONPATH": os.pathsep.join([str(SIM_DIR), os.environ.get("PYTHONPATH", "")])}
+    n, failed = get_results(runner.test(hdl_toplevel=block, hdl_toplevel_lang="verilog", build_dir=d, test_dir=d,
+                                        test_module=f"eyestereo.sim.{bench}", extra_env=env))
+    assert n > 0 and failed == 0, f"{failed} of {n} cocotb tests failed on Icarus (see {d})"
+    return json.loads((d / "report.json").read_text())
 
 
 def camera(prefix="cam", mhz=18.0, phase=41000, frames=FRAMES, **kw):
@@ -177,3 +210,27 @@ def test_async_fifo(request, data_width, depth, wmhz, rmhz, extra):
     assert rep["words"] > 0 and rep["frames"] and len(rep["frames"]) + rep["dropped"] <= 5
     if "tokens" in extra:
         assert rep["frames"] == [0, 2] and rep["dropped"] == 3 and rep["tokens"] == 3
+
+
+# --- the Verilog conversion on Icarus ------------------------------------------------------------------
+def test_icarus_camera_interface_overflow_and_reset(request):
+    """The same bench on the Verilog conversion: an overflow (stall) and a read-domain reset."""
+    p18, r100 = ClockSpec(ps(18), 41000), ClockSpec(ps(100), 3000)
+    s0, s1 = rclk_edge(line_start(0, 2), p18, r100), rclk_edge(line_start(0, 6), p18, r100)
+    k = rclk_edge(line_start(2, 3) + 10, p18, r100)
+    cfg = dict(timing=BLANK, rclk=[r100.period, r100.phase], rresets=[[k, k + 4]],
+               cameras=[camera(frames=FRAMES + ["random:4"], stalls=[[s0, s1]])])
+    rep = _run("camera_interface", "tb_camera_interface", cfg, request, dict(CAM, depth=16), sim="icarus")
+    s = rep["sides"][0]
+    assert s["frames"] == [1, 3] and s["dropped"] == 1 and [c[0] for c in s["cut_by_rrst"]] == [2]
+
+
+def test_icarus_camera_stream_and_fifo(request):
+    params = dict(CAM, order="VYUY", vsync_active=0, href_active=1, luma=True)
+    cfg = dict(timing=BLANK, pclk=[ps(18), 30000], frames=FRAMES, faults={"1": {"line_bytes": {"2": 13}}})
+    rep = _run("camera_stream", "tb_camera_stream", cfg, request, params, sim="icarus")
+    assert rep["frames"] == [0, 2] and [a[0] for a in rep["aborted"]] == [1]
+    cfg = dict(params=dict(data_width=16, depth=16), wclk=[ps(100), 5000], rclk=[ps(40), 1234], width=6,
+               height=3, frames=5, duty=1.0, gap=20, tokens={"1": 9})
+    rep = _run("async_fifo", "tb_async_fifo", cfg, request, cfg["params"], sim="icarus")
+    assert rep["frames"] == [0, 2] and rep["dropped"] == 3
