@@ -1,4 +1,4 @@
-"""The camera bus: what an OmniVision OV6630 (or any camera with a DVP-style parallel port) drives.
+r"""The camera bus: what an OmniVision OV6630 (or any camera with a DVP-style parallel port) drives.
 
 Thesis 7.1 (Fig. 7.3): each camera sends 8-bit YUV 4:2:2 with its own pixel clock, a frame sync and a
 line reference. The FPGA only listens; all four signals come from the camera.
@@ -21,14 +21,13 @@ Fields (ports come out as ``<arg>_<field>``, e.g. ``cam_pclk``, ``cam_data``):
     ``VYUY``; Y0 and Y1 are the luma of the pair's even and odd pixel, U and V the chroma both share.
 
 Timing of the end of a frame, the vertical sync and a 4-pixel line (8 bytes; ``#`` high = active, ``_``
-low, ``.`` don't care; one column per PCLK, data sampled at the rising edge in the middle of each
-column)::
+low, ``.`` don't care; one column per PCLK: the values the rising edge ``/`` of that column samples)::
 
-    pclk    _/~\\_/~\\_/~\\_/~\\_/~\\_/~\\_/~\\_/~\\_/~\\_/~\\_/~\\_/~\\_/~\\_/~\\_/~\\_/~\\_/~\\_/~\\_
+    pclk    _/~~\_/~~\_/~~\_/~~\_/~~\_/~~\_/~~\_/~~\_/~~\_/~~\_/~~\_/~~\_/~~\_/~~\_/~~\_/~~\_/~~\_/~~\
     vsync    _    #    #    #    _    _    _    _    _    _    _    _    _    _    _    _    _    _
     href     _    _    _    _    _    #    #    #    #    #    #    #    #    _    _    #    #    #
     data     .    .    .    .    .    Y0   U0   Y1   V0   Y2   U2   Y3   V2   .    .    Y0   U0   Y1
-             |  vertical sync     |    line 0: 2 x width bytes          | h. blank | line 1 ...
+             |  vertical sync |       line 0: 2 x width bytes         |h.blank | line 1 ...
 
 (The blanking is shortened; the defaults of :class:`eyestereo.tools.camera.CameraTiming` are 192 PCLK of
 horizontal blanking and 3 + 19 + 86 blank line periods around the 288 lines: 50 frames/s at 17.73 MHz.)

@@ -33,7 +33,7 @@ def camera_interface(cam, wrst, rclk, rrst, source, dropped, *, width: int = 352
 
     Parameters:
         width, height, order, vsync_active, href_active: of camera_stream (the camera's geometry and bus).
-        depth: FIFO entries (power of two; 1024 = one RAMB16, absorbs a reader stall of 113 us at the
+        depth: FIFO entries (power of two; 1024 = one RAMB16, absorbs a reader stall of 135 us at the
             OV6630's 9 M words/s: see docs/camera.md).
 
     Latency: camera_stream's 1 PCLK, one PCLK into the FIFO, then three ``rclk`` edges (synchroniser and

@@ -200,14 +200,16 @@ def report(depths, full, resources) -> str:
                      f"{d['drop']} clocks | {ram} |")
     lines += [
         "",
-        "A stall shorter than a line costs one entry per word that arrives in it (plus the output "
-        "register and the synchronisers' two or three clocks); longer stalls also span the horizontal "
-        "blanking, in which nothing arrives, so 512 entries and more absorb more than a line's worth of "
-        "time.",
+        "A stall costs one entry per word that arrives while it lasts: at the boundary exactly `depth` "
+        "words arrive (the word held in the output register and the synchronisers' two or three clocks "
+        "of delay before the writer sees the reader resume cancel out). Within a line that is depth / 9 us; "
+        "a stall longer than a line also spans horizontal blanking, in which nothing arrives, so from 512 "
+        "entries on a stall absorbs more time per entry.",
         "",
         "**Chosen: 1024 entries** (the default of `camera_interface`). At 18 bits (16 data + eol + eof) one "
-        "Spartan-3E RAMB16 holds 1024 entries (as 512 x 36 or 1024 x 18: a smaller depth saves no block "
-        f"RAM), so 1024 is the most stall a block RAM can absorb: {by.get(1024, {}).get('keep_us', float('nan')):.0f} us, "
+        "Spartan-3E RAMB16 holds 1024 entries (1024 x 18), and every depth from 32 to 1024 takes one "
+        "RAMB16 (the table), so 1024 is the most stall one block RAM can absorb: "
+        f"{by.get(1024, {}).get('keep_us', float('nan')):.0f} us, "
         f"{by.get(1024, {}).get('keep', 0):,} SRAM clocks at 100 MHz, far beyond what an arbiter that gives the "
         "camera writers priority makes them wait. "
         "Two cameras take 2 of the 20 RAMB16 (the thesis's stereo Harris needs 12). If block RAM is "
@@ -215,10 +217,7 @@ def report(depths, full, resources) -> str:
         f"{by.get(16, {}).get('keep_us', float('nan')):.1f} us ({by.get(16, {}).get('keep', 0)} SRAM clocks); "
         "the SRAM arbiter's measured "
         "worst wait for a camera writer (issue 12) must stay below the figure of the depth chosen.",
-        "",
-        "Which depth a stall needs is the number of words that arrive while it lasts (the column above: "
-        "exactly the depth at the boundary, the output register and the synchronisers' latency cancelling "
-        "out): at 9 M words/s, depth / 9 us within a line.",
+
         "",
         "## Full frames at the thesis's clocks",
         "",
@@ -227,8 +226,8 @@ def report(depths, full, resources) -> str:
         "frame with the camera image.",
         "",
         "| case | frames | words | same read edge as the model | latency, bus -> system clock | "
-        "wall time | monitor wakes / word |",
-        "|---|---:|---:|---:|---:|---:|---:|",
+        "simulated | wall time | monitor wakes / word |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in full:
         for s in r["sides"]:
@@ -236,7 +235,8 @@ def report(depths, full, resources) -> str:
             wakes = s["monitor_wakes"] / max(1, s["words"])
             lines.append(f"| {r['name']}{' (' + s['name'] + ')' if len(r['sides']) > 1 else ''} | "
                          f"{len(s['frames'])} | {s['words']} | {s['edges_equal']} | "
-                         f"{lat[0] / 1000:.0f}..{lat[1] / 1000:.0f} ns | {r['total_seconds']:.0f} s | "
+                         f"{lat[0] / 1000:.0f}..{lat[1] / 1000:.0f} ns | {r['sim_ps'] / 1e9:.1f} ms | "
+                         f"{r['total_seconds']:.0f} s | "
                          f"{wakes:.1f} |")
     lines += [
         "",
@@ -271,7 +271,13 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description="Measure the camera path: FIFO depth, full frames, resources.")
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "camera.md")
     ap.add_argument("--quick", action="store_true", help="three depths, one full frame (a smoke run)")
+    ap.add_argument("--report-only", action="store_true",
+                    help="rewrite the page from the last run's build/bench_camera.json")
     args = ap.parse_args(argv)
+    if args.report_only:
+        d = json.loads((BUILD.parent / "bench_camera.json").read_text())
+        args.out.write_text(report(d["depths"], d["full"], d["resources"]))
+        return 0
     depths = measure_depths([16, 64, 1024] if args.quick else DEPTHS)
     full = [full_case(*c) for c in (FULL[2:3] if args.quick else FULL)]
     resources = []
