@@ -20,8 +20,10 @@ def camera_interface(cam, wrst, rclk, rrst, source, dropped, *, width: int = 352
     :data:`eyestereo.tools.camera.WORD`), whole: a frame the camera broke, that began before the block
     was listening, or that overflowed the FIFO because the reader stalled too long, never ends with
     ``eof``; if part of it had come out, a reset token ends it (see :mod:`eyestereo.hdl.queue`).
-    Frames broken by the camera, by the FIFO, or by ``wrst`` are counted in ``dropped``; frames the
-    camera_stream never started (no VSYNC seen) are not.
+    ``dropped`` counts the frames that began on the write side (a word of them reached the FIFO, or was
+    lost there) and did not come through: broken by the camera, by an overflow, or by ``wrst``. Frames
+    camera_stream never started (no VSYNC seen) or broke before their first word are not counted; a
+    frame cut on the read side by ``rrst`` is not counted either (the reader was reset with it).
 
     Ports:
         cam: :class:`~eyestereo.hdl.camera_bus.CameraBus`; ``cam_pclk`` clocks the camera domain.
