@@ -68,6 +68,7 @@ bench: setup
 	$(PY) -m eyestereo.tools.reports.bench_ffc --out docs/ffc.md
 	$(PY) -m eyestereo.tools.reports.bench_matching --middlebury $(SHARED)/middlebury --out docs/matching.md \
 	  --img docs/img
+	$(PY) -m eyestereo.sim.bench_camera --out docs/camera.md
 
 clean:
 	rm -rf build .pytest_cache .hypothesis

@@ -12,6 +12,10 @@ from typing import Callable
 import numpy as np
 from myhdl import ResetSignal, Signal, intbv
 
+from eyestereo.hdl.async_fifo import async_fifo
+from eyestereo.hdl.camera_bus import CameraBus
+from eyestereo.hdl.camera_interface import camera_interface, camera_pair
+from eyestereo.hdl.camera_stream import camera_stream
 from eyestereo.hdl.convolve import convolve
 from eyestereo.hdl.cornerness import cornerness
 from eyestereo.hdl.harris_mono import harris_mono
@@ -21,7 +25,9 @@ from eyestereo.hdl.prethreshold import prethreshold
 from eyestereo.hdl.line_delay import line_delay
 from eyestereo.hdl.sobel import sobel
 from eyestereo.hdl.stream_checker import stream_checker
+from eyestereo.hdl.queue import QueuePort
 from eyestereo.hdl.stream import ImageStream
+from eyestereo.tools.camera import WORD as CAMERA_WORD
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import harris_window as window_model
 from eyestereo.tools.models import nms as nms_model
@@ -41,6 +47,9 @@ class BlockSpec:
     hw_params: tuple[str, ...] = field(default=())  # parameters passed to the block function
     #: control ports after ``source``, in order: name -> function(params) -> fresh Signal
     control: tuple[tuple[str, Callable[[dict], object]], ...] = field(default=())
+    #: blocks whose ports are not ``clk, rst, sink, source, <control>`` (several clocks, a camera bus,
+    #: a queue port): function(params) -> (instance, ports dict) of a fresh instance
+    build: Callable[[dict], tuple[object, dict]] | None = None
 
     def params(self, **overrides) -> dict:
         unknown = set(overrides) - set(self.defaults)
@@ -54,14 +63,18 @@ class BlockSpec:
         """(fresh ports in call order, the block function's keyword parameters, all parameters).
 
         A ``stereo`` parameter (blocks that take stereo streams have one) makes both streams stereo.
+        Blocks whose ports are not ``clk, rst, sink, source, <control>`` (several clocks, other
+        interfaces) make their ports with their ``build`` function.
         """
         p = self.params(**overrides)
+        kw = {k: v for k, v in p.items() if k in self.hw_params}
+        if self.build is not None:
+            return self.build(p), kw, p
         stereo = bool(p.get("stereo", False))
         ports = dict(clk=Signal(bool(0)), rst=ResetSignal(0, active=1, isasync=False),
                      sink=ImageStream(self.sink_width(p), stereo=stereo),
                      source=ImageStream(self.source_width(p), stereo=stereo))
         ports.update((name, make(p)) for name, make in self.control)
-        kw = {k: v for k, v in p.items() if k in self.hw_params}
         return ports, kw, p
 
     def elaborate(self, **overrides):
@@ -90,6 +103,39 @@ def _thr_ports():
 def _conv_width(p):
     k, _ = check_kernel(p.get("kernel"), p.get("col"), p.get("row"))
     return output_width(k, p["data_width"], p["shift"])[0]
+
+
+def _rst():
+    return ResetSignal(0, active=1, isasync=False)
+
+
+_CAMERA = dict(width=352, height=288, order="YUYV", vsync_active=1, href_active=1)
+
+
+def _build_camera_stream(p):
+    ports = dict(cam=CameraBus(), rst=_rst(), source=ImageStream(CAMERA_WORD),
+                 luma=ImageStream(8) if p["luma"] else None)
+    return ports
+
+
+def _build_async_fifo(p):
+    ports = dict(wclk=Signal(bool(0)), wrst=_rst(), sink=ImageStream(p["data_width"]), rclk=Signal(bool(0)),
+                 rrst=_rst(), source=QueuePort(p["data_width"]), dropped=Signal(intbv(0)[16:]),
+                 full=Signal(bool(0)), empty=Signal(bool(0)))
+    return ports
+
+
+def _build_camera_interface(p):
+    ports = dict(cam=CameraBus(), wrst=_rst(), rclk=Signal(bool(0)), rrst=_rst(),
+                 source=QueuePort(CAMERA_WORD), dropped=Signal(intbv(0)[16:]))
+    return ports
+
+
+def _build_camera_pair(p):
+    ports = dict(cam_l=CameraBus(), wrst_l=_rst(), cam_r=CameraBus(), wrst_r=_rst(), rclk=Signal(bool(0)),
+                 rrst=_rst(), source_l=QueuePort(CAMERA_WORD), source_r=QueuePort(CAMERA_WORD),
+                 dropped_l=Signal(intbv(0)[16:]), dropped_r=Signal(intbv(0)[16:]))
+    return ports
 
 
 BLOCKS: dict[str, BlockSpec] = {
@@ -140,6 +186,22 @@ BLOCKS: dict[str, BlockSpec] = {
         hw_params=("width", "height", "repair"),
         control=(("error", lambda p: Signal(bool(0))),
                  ("code", lambda p: Signal(intbv(0)[checker_model.CODE_BITS:])))),
+    "camera_stream": BlockSpec(
+        "camera_stream", "camera bus (PCLK, VSYNC, HREF, 8-bit YUV 4:2:2) to 16-bit words, whole frames only",
+        camera_stream, dict(_CAMERA, luma=True), sink_width=lambda p: 8, source_width=lambda p: CAMERA_WORD.width,
+        hw_params=tuple(_CAMERA), build=_build_camera_stream),
+    "async_fifo": BlockSpec(
+        "async_fifo", "dual-clock frame FIFO: Gray pointers, a reset per domain, broken frames dropped and counted",
+        async_fifo, dict(data_width=CAMERA_WORD.width, depth=1024), sink_width=lambda p: p["data_width"],
+        source_width=lambda p: p["data_width"], hw_params=("depth",), build=_build_async_fifo),
+    "camera_interface": BlockSpec(
+        "camera_interface", "camera_stream + async_fifo: a camera bus in, whole frames in the system clock out",
+        camera_interface, dict(_CAMERA, depth=1024), sink_width=lambda p: 8,
+        source_width=lambda p: CAMERA_WORD.width, hw_params=(*_CAMERA, "depth"), build=_build_camera_interface),
+    "camera_pair": BlockSpec(
+        "camera_pair", "two camera_interfaces, each with its own camera clock, into one system clock",
+        camera_pair, dict(_CAMERA, depth=1024), sink_width=lambda p: 8, source_width=lambda p: CAMERA_WORD.width,
+        hw_params=(*_CAMERA, "depth"), build=_build_camera_pair),
 }
 
 
