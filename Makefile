@@ -53,8 +53,11 @@ test: setup
 demo: setup
 	$(PY) -m eyestereo.sim.demo --out build/demo
 
+# GHDL's netlist of every block's VHDL -> Yosys (Spartan-3E resources) and nextpnr-ecp5 (fmax per clock);
+# the table goes to build/synth/resources.md and into docs/benchmarks.md's synth section.
+SYNTH_JOBS ?= 1
 synth: setup
-	$(PY) -m eyestereo.hdl.synth --out build/synth
+	$(PY) -m eyestereo.hdl.synth --out build/synth --doc docs/benchmarks.md --jobs $(SYNTH_JOBS)
 
 # The report scripts take their inputs and outputs as arguments; real data beyond tests/data comes
 # from SHARED (a missing data set is left out of the report and said so).

@@ -12,6 +12,8 @@ from typing import Callable
 import numpy as np
 from myhdl import ResetSignal, Signal, intbv
 
+from eyestereo.hdl.axis import AxiStream
+from eyestereo.hdl.axis_to_stream import axis_to_stream
 from eyestereo.hdl.convolve import convolve
 from eyestereo.hdl.cornerness import cornerness
 from eyestereo.hdl.harris_mono import harris_mono
@@ -22,6 +24,7 @@ from eyestereo.hdl.line_delay import line_delay
 from eyestereo.hdl.sobel import sobel
 from eyestereo.hdl.stream_checker import stream_checker
 from eyestereo.hdl.stream import ImageStream
+from eyestereo.hdl.stream_to_axis import stream_to_axis
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import harris_window as window_model
 from eyestereo.tools.models import nms as nms_model
@@ -41,6 +44,11 @@ class BlockSpec:
     hw_params: tuple[str, ...] = field(default=())  # parameters passed to the block function
     #: control ports after ``source``, in order: name -> function(params) -> fresh Signal
     control: tuple[tuple[str, Callable[[dict], object]], ...] = field(default=())
+    #: interface classes of ``sink`` and ``source`` (built with the stream width)
+    sink_type: type = ImageStream
+    source_type: type = ImageStream
+    #: clock ports with the thesis's goal in MHz (None: none, or the default of eyestereo.hdl.synth)
+    clocks: tuple[tuple[str, float | None], ...] = (("clk", None),)
 
     def params(self, **overrides) -> dict:
         unknown = set(overrides) - set(self.defaults)
@@ -57,9 +65,13 @@ class BlockSpec:
         """
         p = self.params(**overrides)
         stereo = bool(p.get("stereo", False))
+
+        def stream(kind, width):
+            return kind(width, stereo=stereo) if kind is ImageStream else kind(width)
+
         ports = dict(clk=Signal(bool(0)), rst=ResetSignal(0, active=1, isasync=False),
-                     sink=ImageStream(self.sink_width(p), stereo=stereo),
-                     source=ImageStream(self.source_width(p), stereo=stereo))
+                     sink=stream(self.sink_type, self.sink_width(p)),
+                     source=stream(self.source_type, self.source_width(p)))
         ports.update((name, make(p)) for name, make in self.control)
         kw = {k: v for k, v in p.items() if k in self.hw_params}
         return ports, kw, p
@@ -140,6 +152,18 @@ BLOCKS: dict[str, BlockSpec] = {
         hw_params=("width", "height", "repair"),
         control=(("error", lambda p: Signal(bool(0))),
                  ("code", lambda p: Signal(intbv(0)[checker_model.CODE_BITS:])))),
+    "stream_to_axis": BlockSpec(
+        "stream_to_axis", "image stream -> AXI4-Stream video (UG934), FIFO for tready, cut frames on overflow",
+        stream_to_axis, dict(width=352, height=288, data_width=8, depth=1024, commit="line"),
+        sink_width=lambda p: p["data_width"], source_width=lambda p: p["data_width"],
+        hw_params=("width", "height", "depth", "commit"), source_type=AxiStream,
+        control=(("overflow", lambda p: Signal(bool(0))),)),
+    "axis_to_stream": BlockSpec(
+        "axis_to_stream", "AXI4-Stream video (UG934) -> image stream of a fixed geometry, tokens for faults",
+        axis_to_stream, dict(width=352, height=288, data_width=8),
+        sink_width=lambda p: p["data_width"], source_width=lambda p: p["data_width"],
+        hw_params=("width", "height"), sink_type=AxiStream,
+        control=(("error", lambda p: Signal(bool(0))),)),
 }
 
 

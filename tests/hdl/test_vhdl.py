@@ -26,12 +26,15 @@ def test_make_vhdl_writes_and_analyses_every_block(tmp_path):
     for b in manifest["blocks"]:
         assert (tmp_path / f"{b['entity']}.vhd").exists()
         names = [p["name"] for p in b["ports"]]
-        control = [n for n, _ in BLOCKS[b["entity"]].control]
+        spec = BLOCKS[b["entity"]]
+        control = [n for n, _ in spec.control]
+        _, ports, _ = spec.elaborate()
         # MyHDL lists plain signal ports (clk, rst, control) before the flattened stream interfaces.
-        assert names == ["clk", "rst"] + control + ["sink_data", "sink_valid", "sink_eol", "sink_eof",
-                                                     "source_data", "source_valid", "source_eol", "source_eof"]
+        assert names == ["clk", "rst"] + control + [f"sink_{f}" for f in ports["sink"].fields()] + \
+            [f"source_{f}" for f in ports["source"].fields()]
         dirs = {p["name"]: p["dir"] for p in b["ports"]}
-        assert dirs["sink_data"] == "in" and dirs["source_data"] == "out"
+        assert dirs[f"sink_{ports['sink'].fields()[0]}"] == "in"
+        assert dirs[f"source_{ports['source'].fields()[0]}"] == "out"
         assert b["files"][0] == manifest["package"]
         assert b["parameters"]["width"] == 352 and b["parameters"]["height"] == 288
     sobel = next(b for b in manifest["blocks"] if b["entity"] == "sobel")
