@@ -9,7 +9,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-$(shell (cat pyproject.toml 2>/dev/null || echo none) | cksum | cut -d' ' -f1)
 JOBS   ?= 2
 
-.PHONY: all setup ghdl vhdl sim test demo synth bench clean distclean help
+.PHONY: all setup ghdl vhdl sim test demo synth timing bench clean distclean help
 
 all: test
 
@@ -58,6 +58,10 @@ demo: setup
 SYNTH_JOBS ?= 1
 synth: setup
 	$(PY) -m eyestereo.hdl.synth --out build/synth --doc docs/benchmarks.md --jobs $(SYNTH_JOBS)
+
+# WaveDrom diagrams (docs/wavedrom/*.json) -> docs/img/timing/*.svg and docs/timing.md, offline.
+timing: setup
+	$(PY) -m eyestereo.hdl.timing
 
 # The report scripts take their inputs and outputs as arguments; real data beyond tests/data comes
 # from SHARED (a missing data set is left out of the report and said so).

@@ -46,17 +46,21 @@ def axis_to_stream(clk, rst, sink, source, error, *, width: int = 352, height: i
     Resources: column and row counters, the output registers, one held word; no memory, no multipliers.
 
     Handshakes: AXI4-Stream video (``hdl/axis.py``) in, the image stream (``hdl/stream.py``) out.
-    An early SOF in a 4x2 frame (``tok``: the reset token)::
+    An early SOF in 4x2 frames (``tok``: the reset token; WaveDrom: ``docs/wavedrom/axis_to_stream_early_sof.json``)::
 
-        cycle    0    1    2    3    4    5
-        tvalid   #    #    #    #    #    _
-        tready   #    #    #    #    _    #
-        tuser    #    _    _    #    .    .
-        tlast    _    _    _    _    .    .
-        tdata   0,0  1,0  2,0  0,0   .    .       SOF after 3 pixels of line 0
-        valid    _    #    #    #    #    #
-        data     .   0,0  1,0  2,0  tok  0,0      the cut frame ends in a token
-        eof      .    _    _    _    #    _
+        cycle    0    1    2    3    4    5    6
+        tvalid   #    #    #    #    #    #    _
+        tready   #    #    #    #    _    #    #
+        tuser    #    _    _    #    _    _    .
+        tlast    _    _    _    _    _    _    .
+        tdata   0,0  1,0  2,0  0,0  1,0  1,0   .
+        valid    _    #    #    #    #    #    #
+        data     .   0,0  1,0  2,0  tok  0,0  1,0
+        eof      .    _    _    _    #    _    _
+        error    _    _    _    _    #    _    _
+
+    The SOF in cycle 3 comes after 3 pixels of line 0: the frame is aborted with a token, the SOF
+    pixel follows one clock later, and ``tready`` is low for that clock (the next transfer waits).
     """
     check_clock(clk)
     check_reset(rst)

@@ -53,15 +53,20 @@ def stream_to_axis(clk, rst, sink, source, overflow, *, width: int = 352, height
     pointers, a two-word output stage; no multipliers.
 
     Handshakes: the image stream's (``hdl/stream.py``) in, AXI4-Stream video (``hdl/axis.py``) out.
-    Overflow of a 4-pixel line with ``depth = 4``, ``tready`` held low (``w`` = words in the FIFO)::
+    Overflow of 4-pixel lines with ``depth = 4``, ``tready`` held low (``words``: words in the FIFO; the
+    WaveDrom form is ``docs/wavedrom/stream_to_axis_overflow.json``)::
 
         cycle     0    1    2    3    4    5    6
         valid     #    #    #    #    #    #    #
         data     0,0  1,0  2,0  3,0  0,1  1,1  2,1
         eol       _    _    _    #    _    _    _
-        w         0    1    2    3    4    0    0      (3,0) commits the line at 4 words
-        overflow  _    _    _    _    #    _    _      (0,1) finds the FIFO full: frame cut
-        tvalid    _    _    _    _    _    #    #      line 0 offered, waits for tready
+        words     0    1    2    3    4    3    2
+        overflow  _    _    _    _    _    #    _
+        tvalid    _    _    _    _    _    _    #
+
+    (3,0) commits line 0 and the AXI side starts reading it; (0,1) finds the FIFO full, so ``overflow``
+    pulses and (0,1), (1,1), ... up to the frame's end are dropped; line 0 is offered from cycle 6 and
+    waits for ``tready``.
     """
     check_clock(clk)
     check_reset(rst)
