@@ -64,6 +64,10 @@ THESIS_FMAX = {"harris_mono": 65.0}
 
 #: Configurations beyond each block's default that the report also synthesizes: (label, block, params).
 VARIANTS = [
+    # Thesis Table 6.1 (separated against unseparated convolution), on one Sobel kernel (Ix):
+    ("convolve sobel-x separable", "convolve", dict(col=(1, 2, 1), row=(-1, 0, 1), shift=0, kernel=None)),
+    ("convolve sobel-x full", "convolve", dict(kernel=((-1, 0, 1), (-2, 0, 2), (-1, 0, 1)), col=None, row=None,
+                                               shift=0)),
     ("prethreshold 1x1", "prethreshold", dict(blocks=(1, 1))),
     ("nms 1x1", "nms", dict(size=1)),
     ("nms 5x5", "nms", dict(size=5)),
