@@ -348,8 +348,7 @@ def section_convolution(ctx: Context) -> list[str]:
                  sep["summary"]["LUT"] if sep else "-"])
     out += _table(["module", "thesis LUTs unseparated", "thesis LUTs separated", "LUTs unseparated",
                    "LUTs separated"], rows)
-    out += ["", "Table 6.2: non-maximum suppression. Only the separated form is built here (the unseparated "
-            "one has no advantage).", ""]
+    out += ["", "Table 6.2: non-maximum suppression; the library builds only the separated form.", ""]
     rows = [[name, un, se, "-", res[label]["summary"]["LUT"] if label in res else "-"]
             for (name, un, se), label in zip(THESIS_6_2, ("nms", "nms 5x5"))]
     out += _table(["module", "thesis LUTs unseparated", "thesis LUTs separated", "LUTs unseparated",
