@@ -124,6 +124,28 @@ def test_netlist_equals_model(request, block):
 
 @needs_tools
 @pytest.mark.sim
+def test_axis_bridges_netlists(request):
+    """The AXI4-Stream bridges as synthesized, under back-pressure and with an overflow, on Icarus."""
+    from eyestereo.sim.netlist import run_netlist_bench
+
+    frames = ["random:1", "random:2", "random:3"]
+    rep = run_netlist_bench("stream_to_axis", "tb_stream_to_axis",
+                            dict(frames=frames, duty=0.5, pause=0.3, seed=3, expect="exact"),
+                            name=request.node.name + "_exact", params=dict(SMALL, depth=64))
+    assert rep["whole"] == [0, 1, 2] and rep["overflows"] == 0
+    rep = run_netlist_bench("stream_to_axis", "tb_stream_to_axis",
+                            dict(frames=frames + ["random:4"], duty=1.0, pause=0.5, seed=7, expect="cut"),
+                            name=request.node.name + "_cut", params=dict(SMALL, depth=32))
+    assert rep["overflows"] >= 2
+    rep = run_netlist_bench("axis_to_stream", "tb_axis_to_stream",
+                            dict(frames=frames + ["random:4"], pause=0.3, seed=4,
+                                 faults=[[0, "junk"], [1, "early_sof"], [2, "short_line"]]),
+                            name=request.node.name + "_a2s", params=SMALL)
+    assert rep["tokens"] == 2 and rep["frames"] == 2
+
+
+@needs_tools
+@pytest.mark.sim
 def test_harris_mono_netlist_full_frame(request):
     """The whole mono Harris as make synth measures it, on a real 352x288 frame, 16 block thresholds."""
     thr = [hm.threshold_code(c) for c in (2e8, 4e8, 1e8, 6e8, 3e8, 1e9, 5e7, 2e8,
