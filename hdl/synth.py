@@ -368,7 +368,8 @@ def run(names=None, out: Path = Path("build/synth"), *, pnr: bool = True, freq: 
         if pnr:
             res.update(ecp5(job, freq=freq))
         res["seconds"] = round(time.perf_counter() - t0, 1)
-        fm = f", fmax {_fmax_cell(res)} MHz" if pnr else ""
+        cell = _fmax_cell(res)
+        fm = (f", fmax {cell} MHz" if cell[:1].isdigit() or ":" in cell else f", fmax: {cell}") if pnr else ""
         progress(f"synth: {job['label']}: {res['summary']['LUT']} LUT, {res['summary']['RAMB16']} RAMB16, "
                  f"{res['summary']['MULT18X18']} MULT{fm} ({res['seconds']} s)")
         return res
