@@ -65,7 +65,7 @@ timing: setup
 
 # Every reproducible table and figure of the thesis -> docs/thesis.md (+ docs/img/thesis/); runs make synth first.
 report: synth
-	$(PY) -m eyestereo.tools.reports.thesis --out docs/thesis.md
+	$(PY) -m eyestereo.tools.reports.thesis --out docs/thesis.md --shared $(SHARED)
 
 # The report scripts take their inputs and outputs as arguments; real data beyond tests/data comes
 # from SHARED (a missing data set is left out of the report and said so).

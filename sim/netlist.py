@@ -17,7 +17,8 @@ from cocotb_tools.runner import get_results, get_runner
 
 from eyestereo.hdl.convert import convert
 from eyestereo.hdl.netlist import ghdl_netlist
-from eyestereo.sim.runner import ROOT, SIM_DIR, _jsonable, slug
+from eyestereo.hdl.catalog import jsonable
+from eyestereo.sim.runner import ROOT, SIM_DIR, slug
 
 BUILD = ROOT / "build" / "sim_netlist"
 
@@ -35,7 +36,7 @@ def run_netlist_bench(block: str, bench: str, config: dict, *, name: str, params
     build_dir.mkdir(parents=True)
     files = convert(block, build_dir / "vhdl", **params)
     net = ghdl_netlist(files, block, build_dir)
-    full = dict(config, block=block, params=_jsonable(params), report=str(build_dir / "report.json"))
+    full = dict(config, block=block, params=jsonable(params), report=str(build_dir / "report.json"))
     runner = get_runner("icarus")
     runner.build(sources=[str(net)], hdl_toplevel=block, build_dir=build_dir, always=True,
                  timescale=("1ns", "1ps"))

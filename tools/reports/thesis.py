@@ -84,6 +84,7 @@ class Context:
     img_rel: str
     synth: Path = DEFAULT_SYNTH
     framerate: Path = DEFAULT_FRAMERATE
+    shared: Path = SHARED  # the project's shared data (Middlebury, the OpenCV calibration pairs)
     quick: bool = False  # small sizes and sweeps (tests)
     cache: dict = field(default_factory=dict)
 
@@ -151,11 +152,11 @@ def _stat_row(s: dict) -> list[str]:
     return [f(s[k][c]) for k in ("max", "mean", "var") for c in ("x", "y", "r")]
 
 
-def _opencv_maps():
+def _opencv_maps(shared: Path):
     from eyestereo.tools.rectify.calib import calibrate_stereo
     from eyestereo.tools.rectify.maps import compute_maps
 
-    d = SHARED / "opencv_stereo_calib"
+    d = shared / "opencv_stereo_calib"
     if not (d / "left01.jpg").is_file():
         return None
     calib = calibrate_stereo(str(d / "left*.jpg"), str(d / "right*.jpg"), board=(9, 6), square=0.025,
@@ -171,7 +172,7 @@ def section_regression(ctx: Context) -> list[str]:
     rows = [[f"**thesis** {'none' if k == 'none' else 'degree ' + k}"] + [f"{v:.2f}" for v in vals]
             for k, vals in THESIS_4_1.items()]
     sets = [("synthetic EyeBot rig", maps, fits)]
-    cv = None if ctx.quick else _opencv_maps()
+    cv = None if ctx.quick else _opencv_maps(ctx.shared)
     if cv is not None:
         sets.append(("OpenCV sample pairs (640x480)", cv, _fits(ctx, "cv_fits", cv)))
     for name, m, fs in sets:
@@ -185,7 +186,7 @@ def section_regression(ctx: Context) -> list[str]:
            "(how far rectification moves pixels). The synthetic rig copies the EyeBot M6 (f = 4.9 mm, "
            "9 um pixels, 66 mm baseline, barrel lenses; `eyestereo.tools.rectify.rig`)."
            + ("" if cv is not None or ctx.quick else " The OpenCV sample pairs were not found in "
-              f"`{SHARED / 'opencv_stereo_calib'}` and are left out."), ""]
+              f"`{ctx.shared / 'opencv_stereo_calib'}` and are left out."), ""]
     out += _table(head, rows)
     r3 = fits[3].report["fit"]["both"]["mean"]["r"]
     r2 = fits[2].report["fit"]["both"]["mean"]["r"]
@@ -494,8 +495,7 @@ def section_matching(ctx: Context) -> list[str]:
     """Fig. 7.5 (a) t_max, (b) window size, and the split-correlation gain (bench_matching's studies)."""
     from eyestereo.tools.reports import bench_matching as B
 
-    B.SHARED = SHARED / "middlebury"  # the shared data as this report finds it
-    sets = B.load_sets(lambda m: None)
+    sets = B.load_sets(ctx.shared / "middlebury", lambda m: None)
     if not sets:
         raise NotYetAvailable("no stereo data sets (Middlebury in ../shared/data/middlebury, or scikit-image)")
     if ctx.quick:
@@ -624,12 +624,14 @@ def main(argv=None) -> int:
     ap.add_argument("--img", type=Path, help="figure folder (default: img/thesis next to --out)")
     ap.add_argument("--synth", type=Path, default=DEFAULT_SYNTH, help="make synth's resources.json")
     ap.add_argument("--framerate", type=Path, default=DEFAULT_FRAMERATE, help="the system's frame-rate JSON")
+    ap.add_argument("--shared", type=Path, default=SHARED,
+                    help=f"the shared data folder (Middlebury, OpenCV calibration pairs; default {SHARED})")
     ap.add_argument("--section", action="append", help="only this section (repeatable)")
     ap.add_argument("--quick", action="store_true", help="small images and sweeps (a smoke run)")
     args = ap.parse_args(argv)
     img = args.img or args.out.parent / "img" / "thesis"
     ctx = Context(img=img, img_rel=os.path.relpath(img, args.out.parent), synth=args.synth,
-                  framerate=args.framerate, quick=args.quick)
+                  framerate=args.framerate, shared=args.shared, quick=args.quick)
     import cv2
 
     cv2.setNumThreads(1)
