@@ -83,11 +83,3 @@ class AxiStream:
 
     def __repr__(self) -> str:
         return f"AxiStream(data_width={self.data_width}, tdata={len(self.tdata)} bits)"
-
-
-def check_axis(name: str, port, *, data_width: int | None = None) -> None:
-    """An :class:`AxiStream` port carrying ``data_width``-bit pixels, else a ValueError naming the port."""
-    if not isinstance(port, AxiStream):
-        raise ValueError(f"port {name} must be an AxiStream, got {type(port).__name__} {port!r}"[:120])
-    if data_width is not None and port.data_width != data_width:
-        raise ValueError(f"port {name} must carry {data_width}-bit pixels, got an AxiStream of {port.data_width} bits")

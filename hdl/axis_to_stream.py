@@ -2,8 +2,8 @@
 
 from myhdl import Signal, always_comb, always_seq, block, intbv
 
-from eyestereo.hdl.axis import check_axis
-from eyestereo.hdl.common.checks import check_clock, check_int, check_reset, check_signal, check_stream
+from eyestereo.hdl.common.checks import check_axis, check_clock, check_distinct, check_int, check_reset, \
+    check_signal, check_stream
 
 
 @block
@@ -68,6 +68,7 @@ def axis_to_stream(clk, rst, sink, source, error, *, width: int = 352, height: i
     dw = source.data_width
     check_axis("sink", sink, data_width=dw)
     check_signal("error", error, width=1)
+    check_distinct(dict(source=source, error=error), dict(clk=clk, rst=rst, sink=sink))
     width = check_int("width", width, 1, 4096)
     height = check_int("height", height, 1, 4096)
 

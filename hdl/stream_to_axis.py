@@ -2,9 +2,9 @@
 
 from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv, modbv
 
-from eyestereo.hdl.axis import check_axis, tdata_width
-from eyestereo.hdl.common.checks import check_choice, check_clock, check_int, check_reset, check_signal, \
-    check_stream
+from eyestereo.hdl.axis import tdata_width
+from eyestereo.hdl.common.checks import check_axis, check_choice, check_clock, check_distinct, check_int, \
+    check_reset, check_signal, check_stream
 
 COMMITS = ("line", "frame")
 
@@ -74,6 +74,7 @@ def stream_to_axis(clk, rst, sink, source, overflow, *, width: int = 352, height
     dw = sink.data_width
     check_axis("source", source, data_width=dw)
     check_signal("overflow", overflow, width=1)
+    check_distinct(dict(source=source, overflow=overflow), dict(clk=clk, rst=rst, sink=sink))
     width = check_int("width", width, 1, 4096)
     height = check_int("height", height, 1, 4096)
     depth = check_int("depth", depth, 4, 1 << 16)
