@@ -9,7 +9,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-$(shell (cat pyproject.toml 2>/dev/null || echo none) | cksum | cut -d' ' -f1)
 JOBS   ?= 2
 
-.PHONY: all setup ghdl vhdl sim test demo synth bench clean distclean help
+.PHONY: all setup ghdl vhdl sim test demo synth timing report bench clean distclean help
 
 all: test
 
@@ -53,8 +53,19 @@ test: setup
 demo: setup
 	$(PY) -m eyestereo.sim.demo --out build/demo
 
+# GHDL's netlist of every block's VHDL -> Yosys (Spartan-3E resources) and nextpnr-ecp5 (fmax per clock);
+# the table goes to build/synth/resources.md and into docs/benchmarks.md's synth section.
+SYNTH_JOBS ?= 1
 synth: setup
-	$(PY) -m eyestereo.hdl.synth --out build/synth
+	$(PY) -m eyestereo.hdl.synth --out build/synth --doc docs/benchmarks.md --jobs $(SYNTH_JOBS)
+
+# WaveDrom diagrams (docs/wavedrom/*.json) -> docs/img/timing/*.svg and docs/timing.md, offline.
+timing: setup
+	$(PY) -m eyestereo.hdl.timing
+
+# Every reproducible table and figure of the thesis -> docs/thesis.md (+ docs/img/thesis/); runs make synth first.
+report: synth
+	$(PY) -m eyestereo.tools.reports.thesis --out docs/thesis.md --shared $(SHARED)
 
 # The report scripts take their inputs and outputs as arguments; real data beyond tests/data comes
 # from SHARED (a missing data set is left out of the report and said so).

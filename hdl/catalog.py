@@ -16,6 +16,8 @@ from eyestereo.hdl.async_fifo import async_fifo
 from eyestereo.hdl.camera_bus import CameraBus
 from eyestereo.hdl.camera_interface import camera_interface, camera_pair
 from eyestereo.hdl.camera_stream import camera_stream
+from eyestereo.hdl.axis import AxiStream
+from eyestereo.hdl.axis_to_stream import axis_to_stream
 from eyestereo.hdl.convolve import convolve
 from eyestereo.hdl.cornerness import cornerness
 from eyestereo.hdl.harris_mono import harris_mono
@@ -28,6 +30,7 @@ from eyestereo.hdl.stream_checker import stream_checker
 from eyestereo.hdl.queue import QueuePort
 from eyestereo.hdl.stream import ImageStream
 from eyestereo.tools.camera import WORD as CAMERA_WORD
+from eyestereo.hdl.stream_to_axis import stream_to_axis
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import harris_window as window_model
 from eyestereo.tools.models import nms as nms_model
@@ -50,6 +53,11 @@ class BlockSpec:
     #: blocks whose ports are not ``clk, rst, sink, source, <control>`` (several clocks, a camera bus,
     #: a queue port): function(params) -> (instance, ports dict) of a fresh instance
     build: Callable[[dict], tuple[object, dict]] | None = None
+    #: interface classes of ``sink`` and ``source`` (built with the stream width)
+    sink_type: type = ImageStream
+    source_type: type = ImageStream
+    #: clock ports with the thesis's goal in MHz (None: none, or the default of eyestereo.hdl.synth)
+    clocks: tuple[tuple[str, float | None], ...] = (("clk", None),)
 
     def params(self, **overrides) -> dict:
         unknown = set(overrides) - set(self.defaults)
@@ -71,9 +79,13 @@ class BlockSpec:
         if self.build is not None:
             return self.build(p), kw, p
         stereo = bool(p.get("stereo", False))
+
+        def stream(kind, width):
+            return kind(width, stereo=stereo) if kind is ImageStream else kind(width)
+
         ports = dict(clk=Signal(bool(0)), rst=ResetSignal(0, active=1, isasync=False),
-                     sink=ImageStream(self.sink_width(p), stereo=stereo),
-                     source=ImageStream(self.source_width(p), stereo=stereo))
+                     sink=stream(self.sink_type, self.sink_width(p)),
+                     source=stream(self.source_type, self.source_width(p)))
         ports.update((name, make(p)) for name, make in self.control)
         return ports, kw, p
 
@@ -189,19 +201,34 @@ BLOCKS: dict[str, BlockSpec] = {
     "camera_stream": BlockSpec(
         "camera_stream", "camera bus (PCLK, VSYNC, HREF, 8-bit YUV 4:2:2) to 16-bit words, whole frames only",
         camera_stream, dict(_CAMERA, luma=True), sink_width=lambda p: 8, source_width=lambda p: CAMERA_WORD.width,
-        hw_params=tuple(_CAMERA), build=_build_camera_stream),
+        hw_params=tuple(_CAMERA), build=_build_camera_stream, clocks=(("cam_pclk", 18.0),)),
     "async_fifo": BlockSpec(
         "async_fifo", "dual-clock frame FIFO: Gray pointers, a reset per domain, broken frames dropped and counted",
         async_fifo, dict(data_width=CAMERA_WORD.width, depth=1024), sink_width=lambda p: p["data_width"],
-        source_width=lambda p: p["data_width"], hw_params=("depth",), build=_build_async_fifo),
+        source_width=lambda p: p["data_width"], hw_params=("depth",), build=_build_async_fifo,
+        clocks=(("wclk", 18.0), ("rclk", 100.0))),
     "camera_interface": BlockSpec(
         "camera_interface", "camera_stream + async_fifo: a camera bus in, whole frames in the system clock out",
         camera_interface, dict(_CAMERA, depth=1024), sink_width=lambda p: 8,
-        source_width=lambda p: CAMERA_WORD.width, hw_params=(*_CAMERA, "depth"), build=_build_camera_interface),
+        source_width=lambda p: CAMERA_WORD.width, hw_params=(*_CAMERA, "depth"), build=_build_camera_interface,
+        clocks=(("cam_pclk", 18.0), ("rclk", 100.0))),
     "camera_pair": BlockSpec(
         "camera_pair", "two camera_interfaces, each with its own camera clock, into one system clock",
         camera_pair, dict(_CAMERA, depth=1024), sink_width=lambda p: 8, source_width=lambda p: CAMERA_WORD.width,
-        hw_params=(*_CAMERA, "depth"), build=_build_camera_pair),
+        hw_params=(*_CAMERA, "depth"), build=_build_camera_pair,
+        clocks=(("cam_l_pclk", 18.0), ("cam_r_pclk", 18.0), ("rclk", 100.0))),
+    "stream_to_axis": BlockSpec(
+        "stream_to_axis", "image stream -> AXI4-Stream video (UG934), FIFO for tready, cut frames on overflow",
+        stream_to_axis, dict(width=352, height=288, data_width=8, depth=1024, commit="line"),
+        sink_width=lambda p: p["data_width"], source_width=lambda p: p["data_width"],
+        hw_params=("width", "height", "depth", "commit"), source_type=AxiStream,
+        control=(("overflow", lambda p: Signal(bool(0))),)),
+    "axis_to_stream": BlockSpec(
+        "axis_to_stream", "AXI4-Stream video (UG934) -> image stream of a fixed geometry, tokens for faults",
+        axis_to_stream, dict(width=352, height=288, data_width=8),
+        sink_width=lambda p: p["data_width"], source_width=lambda p: p["data_width"],
+        hw_params=("width", "height"), sink_type=AxiStream,
+        control=(("error", lambda p: Signal(bool(0))),)),
 }
 
 

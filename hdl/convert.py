@@ -84,7 +84,10 @@ def analyse(files: list[Path], std: str, workdir: Path) -> None:
 
 
 def make_vhdl(out: Path) -> dict:
-    """Write the default configuration of every block to ``out`` with its manifest, then analyse it."""
+    """Write the default configuration of every block to ``out`` with its manifest, then analyse it.
+
+    Also writes a FuseSoC core per block (:mod:`eyestereo.hdl.fusesoc`).
+    """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     manifest = {"blocks": [], "package": None, "ghdl_std": list(GHDL_STDS)}
@@ -104,6 +107,9 @@ def make_vhdl(out: Path) -> dict:
     for std in GHDL_STDS:
         with tempfile.TemporaryDirectory() as tmp:
             analyse([out / manifest["package"]] + files, std, Path(tmp))
+    from eyestereo.hdl.fusesoc import write_cores
+
+    manifest["cores"] = [p.name for p in write_cores(out, manifest)]
     (out / "manifest.json").write_text(json.dumps(manifest, indent=2) + "\n")
     return manifest
 
@@ -118,7 +124,7 @@ def main(argv=None) -> int:
         print(f"make vhdl: {e}", file=sys.stderr)
         return 1
     for b in m["blocks"]:
-        print(f"{args.out}/{b['entity']}.vhd  ({len(b['ports'])} ports)")
+        print(f"{args.out}/{b['entity']}.vhd  ({len(b['ports'])} ports)  {b['entity']}.core")
     print(f"analysed with GHDL --std={' and --std='.join(GHDL_STDS)}: OK")
     return 0
 

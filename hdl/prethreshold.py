@@ -75,14 +75,27 @@ def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: i
     xl = Signal(intbv(0, min=0, max=width))
     yl = Signal(intbv(0, min=0, max=height))
 
+    # A write to an index past the last block is ignored. When every address names a block the check
+    # is left out: GHDL 2.0's synthesis truncates the constant of "thr_addr < 16" to 4 bits (0), and
+    # the netlist make synth measures would then never write a threshold.
+    we = Signal(bool(0))
+    if nblk >= (1 << len(thr_addr)):
+        @always_comb
+        def write_check():
+            we.next = thr_we
+    else:
+        @always_comb
+        def write_check():
+            we.next = thr_we and thr_addr < nblk
+
     @always(clk.posedge)
     def ram():
-        if thr_we and thr_addr < nblk:
+        if we:
             mem[thr_addr].next = thr_data
 
     @always_seq(clk.posedge, reset=rst)
     def flags():
-        if thr_we and thr_addr < nblk:
+        if we:
             written.next[thr_addr] = 1
 
     @always_comb
@@ -130,7 +143,7 @@ def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: i
                 if x == xl:
                     bx.next = bx + 1
 
-    return ram, flags, lookup, read, choose, position, pass_greater(clk, rst, sink, source, value, thr)
+    return write_check, ram, flags, lookup, read, choose, position, pass_greater(clk, rst, sink, source, value, thr)
 
 
 @block

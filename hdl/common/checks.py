@@ -34,9 +34,10 @@ import numpy as np
 from myhdl import ResetSignal, intbv
 from myhdl._Signal import _Signal
 
+from eyestereo.hdl.axis import AxiStream
 from eyestereo.hdl.stream import ImageStream
 
-__all__ = ["check_clock", "check_reset", "check_stream", "check_signal", "check_int", "check_choice",
+__all__ = ["check_axis", "check_clock", "check_reset", "check_stream", "check_signal", "check_int", "check_choice",
            "check_bool", "check_frame", "check_distinct", "block_error", "checked"]
 
 #: The largest frame side the blocks' counters are sized for.
@@ -99,7 +100,7 @@ def _what(x) -> str:
             article = "an" if str(n).startswith("8") or n in (11, 18) else "a"
             return f"{article} {n}-bit {kind} Signal(intbv)"
         return f"a Signal of {type(v).__name__} {v!r}"[:80]
-    if isinstance(x, ImageStream):
+    if isinstance(x, (ImageStream, AxiStream)):
         return repr(x)
     return f"{type(x).__name__} {x!r}"[:80]
 
@@ -174,6 +175,18 @@ def check_stream(name: str, stream, *, width: int | None = None, stereo: bool | 
         raise _fail(f"port {name} must be a stereo stream (ImageStream(..., stereo=True)), got a mono one")
 
 
+def check_axis(name: str, port, *, data_width: int | None = None) -> None:
+    """An :class:`~eyestereo.hdl.axis.AxiStream` port carrying ``data_width``-bit pixels."""
+    if not isinstance(port, AxiStream):
+        raise _fail(f"port {name} must be an AxiStream, got {_what(port)}")
+    for f in port.fields():
+        sig = getattr(port, f, None)
+        if not isinstance(sig, _Signal):
+            raise _fail(f"port {name}: field {f} of the AxiStream is {_what(sig)}, not a Signal")
+    if data_width is not None and port.data_width != data_width:
+        raise _fail(f"port {name} must carry {data_width}-bit pixels, got an AxiStream of {port.data_width} bits")
+
+
 def check_distinct(outputs: dict, inputs: dict) -> None:
     """No signal of an output port may belong to any other port: ``sobel(clk, rst, s, s)`` is refused.
 
@@ -181,7 +194,7 @@ def check_distinct(outputs: dict, inputs: dict) -> None:
     signals among themselves (a signal can feed two inputs), an output drives its signals alone.
     """
     def signals(port):
-        if isinstance(port, ImageStream):
+        if isinstance(port, (ImageStream, AxiStream)):  # an AxiStream's tready is an input: still its own
             return [getattr(port, f) for f in port.fields()]
         return [port] if isinstance(port, _Signal) else []
 

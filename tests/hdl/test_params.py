@@ -220,8 +220,9 @@ def test_catalog_default_configuration_elaborates(name):
     if spec.build is not None:  # multi-clock and camera blocks: their ports are checked in test_camera_params
         return
     assert set(ports_) == {"clk", "rst", "sink", "source"} | {n for n, _ in spec.control}
-    assert len(ports_["sink"].data) == spec.sink_width(spec.params())
-    assert len(ports_["source"].data) == spec.source_width(spec.params())
+    # ImageStream and AxiStream both carry data_width (an AxiStream pads tdata to whole bytes)
+    assert ports_["sink"].data_width == spec.sink_width(spec.params())
+    assert ports_["source"].data_width == spec.source_width(spec.params())
 
 
 @pytest.mark.parametrize(
@@ -327,8 +328,9 @@ def test_streams_and_control_ports_swapped(name):
     spec = BLOCKS[name]
     for port in ("sink", "source"):
         ports, kw, _ = spec.ports(**_small(spec))
+        kind = type(ports[port]).__name__  # ImageStream, or AxiStream for the bridges' AXI side
         ports[port] = Signal(intbv(0)[8:])
-        _expect(name, rf"port {port} must be an ImageStream, got an 8-bit unsigned Signal", spec, ports, kw)
+        _expect(name, rf"port {port} must be an {kind}, got an 8-bit unsigned Signal", spec, ports, kw)
     for port, _ in spec.control:
         ports, kw, _ = spec.ports(**_small(spec))
         ports[port] = ImageStream(8)
@@ -341,7 +343,7 @@ def test_wrong_stream_widths(name):
     for port in ("sink", "source"):
         ports, kw, _ = spec.ports(**_small(spec))
         n = ports[port].data_width
-        ports[port] = ImageStream(n + 1)
+        ports[port] = type(ports[port])(n + 1)  # the same kind of interface (ImageStream or AxiStream)
         # Blocks that take any sink width (line_delay, convolve, stream_checker) blame the source.
         _expect(name, rf"port (sink|source) .*({n}.*{n + 1}|{n + 1}.*{n})", spec, ports, kw)
 
@@ -372,11 +374,15 @@ def test_control_port_widths_and_kinds(name):
 def test_an_output_port_needs_signals_of_its_own(name):
     spec = BLOCKS[name]
     ports, kw, _ = spec.ports(**_small(spec))
-    if ports["sink"].data_width == ports["source"].data_width:
+    same_kind = type(ports["sink"]) is type(ports["source"])
+    if same_kind and ports["sink"].data_width == ports["source"].data_width:
         ports["source"] = ports["sink"]
         _expect(name, r"ports source and sink share a signal; the output port source", spec, ports, kw)
     ports, kw, _ = spec.ports(**_small(spec))
-    ports["source"].valid = ports["sink"].valid  # one field shared
+    # one field shared: the valid of each side (tvalid on an AXI4-Stream port)
+    src_valid = "valid" if hasattr(ports["source"], "valid") else "tvalid"
+    snk_valid = "valid" if hasattr(ports["sink"], "valid") else "tvalid"
+    setattr(ports["source"], src_valid, getattr(ports["sink"], snk_valid))
     _expect(name, r"ports source and sink share a signal", spec, ports, kw)
 
 
@@ -394,6 +400,8 @@ def test_stereo_streams_forwarded_or_refused(name):
         return
     for port in ("sink", "source"):
         ports, kw, _ = spec.ports(**_small(spec))
+        if not isinstance(ports[port], ImageStream):
+            continue  # an AXI4-Stream port has no stereo form (the bridges take mono streams)
         ports[port] = ImageStream(ports[port].data_width, stereo=True)
         _expect(name, rf"port {port} is a stereo stream \(with cam\); this block takes mono streams only", spec,
                 ports, kw)
