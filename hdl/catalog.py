@@ -12,6 +12,12 @@ from typing import Callable
 import numpy as np
 from myhdl import ResetSignal, Signal, intbv
 
+from eyestereo.hdl.async_fifo import async_fifo
+from eyestereo.hdl.camera_bus import CameraBus
+from eyestereo.hdl.camera_interface import camera_interface, camera_pair
+from eyestereo.hdl.camera_stream import camera_stream
+from eyestereo.hdl.axis import AxiStream
+from eyestereo.hdl.axis_to_stream import axis_to_stream
 from eyestereo.hdl.convolve import convolve
 from eyestereo.hdl.cornerness import cornerness
 from eyestereo.hdl.harris_mono import harris_mono
@@ -23,11 +29,16 @@ from eyestereo.hdl.coordinate_warper import coordinate_warper
 from eyestereo.hdl.line_delay import line_delay
 from eyestereo.hdl.poly_unit import CoefPort, poly_unit
 from eyestereo.hdl.sobel import sobel
+from eyestereo.hdl.stream_checker import stream_checker
+from eyestereo.hdl.queue import QueuePort
 from eyestereo.hdl.stream import ImageStream
+from eyestereo.tools.camera import WORD as CAMERA_WORD
+from eyestereo.hdl.stream_to_axis import stream_to_axis
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import harris_window as window_model
 from eyestereo.tools.models import nms as nms_model
 from eyestereo.tools.models import sobel as sobel_model
+from eyestereo.tools.models import stream_checker as checker_model
 from eyestereo.tools.models.convolve import check_kernel, output_width
 from eyestereo.tools.models import poly_unit as poly_model
 
@@ -43,14 +54,14 @@ class BlockSpec:
     hw_params: tuple[str, ...] = field(default=())  # parameters passed to the block function
     #: control ports after ``source``, in order: name -> function(params) -> fresh Signal
     control: tuple[tuple[str, Callable[[dict], object]], ...] = field(default=())
-    #: Blocks without an image stream: function(params) -> {port name: fresh Signal or interface} in
-    #: the block's order after clk and rst (then sink_width/source_width/control are unused).
-    ports: Callable[[dict], dict] | None = None
-
-    @property
-    def is_stream(self) -> bool:
-        """Whether the block has the stream ports sink and source (else its ports come from ``ports``)."""
-        return self.ports is None
+    #: blocks whose ports are not ``clk, rst, sink, source, <control>`` (several clocks, a camera bus,
+    #: a queue port): function(params) -> (instance, ports dict) of a fresh instance
+    build: Callable[[dict], tuple[object, dict]] | None = None
+    #: interface classes of ``sink`` and ``source`` (built with the stream width)
+    sink_type: type = ImageStream
+    source_type: type = ImageStream
+    #: clock ports with the thesis's goal in MHz (None: none, or the default of eyestereo.hdl.synth)
+    clocks: tuple[tuple[str, float | None], ...] = (("clk", None),)
 
     def params(self, **overrides) -> dict:
         unknown = set(overrides) - set(self.defaults)
@@ -60,22 +71,33 @@ class BlockSpec:
         p.update(overrides)
         return p
 
-    def elaborate(self, **overrides):
-        """(instance, ports dict) of a fresh instance with the given parameters."""
+    def ports(self, **overrides) -> tuple[dict, dict, dict]:
+        """(fresh ports in call order, the block function's keyword parameters, all parameters).
+
+        A ``stereo`` parameter (blocks that take stereo streams have one) makes both streams stereo.
+        Blocks whose ports are not ``clk, rst, sink, source, <control>`` (several clocks, other
+        interfaces) make their ports with their ``build`` function.
+        """
         p = self.params(**overrides)
-        clk = Signal(bool(0))
-        rst = ResetSignal(0, active=1, isasync=False)
         kw = {k: v for k, v in p.items() if k in self.hw_params}
-        if self.ports is not None:
-            ports = self.ports(p)
-            inst = self.func(clk, rst, *ports.values(), **kw)
-            return inst, dict(clk=clk, rst=rst, **ports), p
-        sink = ImageStream(self.sink_width(p))
-        source = ImageStream(self.source_width(p))
-        kw = {k: v for k, v in p.items() if k in self.hw_params}
-        ctrl = {name: make(p) for name, make in self.control}
-        inst = self.func(clk, rst, sink, source, *ctrl.values(), **kw)
-        return inst, dict(clk=clk, rst=rst, sink=sink, source=source, **ctrl), p
+        if self.build is not None:
+            return self.build(p), kw, p
+        stereo = bool(p.get("stereo", False))
+
+        def stream(kind, width):
+            return kind(width, stereo=stereo) if kind is ImageStream else kind(width)
+
+        ports = dict(clk=Signal(bool(0)), rst=ResetSignal(0, active=1, isasync=False),
+                     sink=stream(self.sink_type, self.sink_width(p)),
+                     source=stream(self.source_type, self.source_width(p)))
+        ports.update((name, make(p)) for name, make in self.control)
+        return ports, kw, p
+
+    def elaborate(self, **overrides):
+        """(instance, ports dict, parameters) of a fresh instance with the given parameters."""
+        ports, kw, p = self.ports(**overrides)
+        inst = self.func(*ports.values(), **kw)
+        return inst, ports, p
 
     def entity(self, **overrides) -> str:
         return self.name
@@ -99,6 +121,39 @@ def _conv_width(p):
     return output_width(k, p["data_width"], p["shift"])[0]
 
 
+def _rst():
+    return ResetSignal(0, active=1, isasync=False)
+
+
+_CAMERA = dict(width=352, height=288, order="YUYV", vsync_active=1, href_active=1)
+
+
+def _build_camera_stream(p):
+    ports = dict(cam=CameraBus(), rst=_rst(), source=ImageStream(CAMERA_WORD),
+                 luma=ImageStream(8) if p["luma"] else None)
+    return ports
+
+
+def _build_async_fifo(p):
+    ports = dict(wclk=Signal(bool(0)), wrst=_rst(), sink=ImageStream(p["data_width"]), rclk=Signal(bool(0)),
+                 rrst=_rst(), source=QueuePort(p["data_width"]), dropped=Signal(intbv(0)[16:]),
+                 full=Signal(bool(0)), empty=Signal(bool(0)))
+    return ports
+
+
+def _build_camera_interface(p):
+    ports = dict(cam=CameraBus(), wrst=_rst(), rclk=Signal(bool(0)), rrst=_rst(),
+                 source=QueuePort(CAMERA_WORD), dropped=Signal(intbv(0)[16:]))
+    return ports
+
+
+def _build_camera_pair(p):
+    ports = dict(cam_l=CameraBus(), wrst_l=_rst(), cam_r=CameraBus(), wrst_r=_rst(), rclk=Signal(bool(0)),
+                 rrst=_rst(), source_l=QueuePort(CAMERA_WORD), source_r=QueuePort(CAMERA_WORD),
+                 dropped_l=Signal(intbv(0)[16:]), dropped_r=Signal(intbv(0)[16:]))
+    return ports
+
+
 #: Rectification blocks: ``quantizers`` is a calibration spec or a quantizers.json path
 #: (:func:`eyestereo.tools.rectify.calibrations.load`; "rig" = the synthetic rig, 352x288).
 _POLY_DEFAULTS = dict(quantizers="rig", frac=poly_model.DEFAULT_FRAC, source_width=None, source_height=None,
@@ -117,18 +172,18 @@ def _coef_port(p, cal):
     return {"coef": CoefPort(poly_model.coef_data_bits(cal.formats))} if p["coefficients"] == "register" else {}
 
 
-def _poly_ports(p):
+def _build_poly_unit(p):
     cal = _calibration(p)
     nb = poly_model.coord_bits(cal, p["frac"])
-    return dict(enable=Signal(bool(0)), x=Signal(intbv(0)[poly_model.int_bits(cal.width):]),
+    return dict(clk=Signal(bool(0)), rst=_rst(), enable=Signal(bool(0)), x=Signal(intbv(0)[poly_model.int_bits(cal.width):]),
                 y=Signal(intbv(0)[poly_model.int_bits(cal.height):]), select_coord=Signal(intbv(0)[3:]),
                 coord=Signal(intbv(0)[nb:]), out_of_range=Signal(bool(0)), select_coord_out=Signal(intbv(0)[3:]),
                 **_coef_port(p, cal))
 
 
-def _warper_ports(p):
+def _build_coordinate_warper(p):
     cal = _calibration(p)
-    return dict(start=Signal(bool(0)), enable=Signal(bool(0)), busy=Signal(bool(0)), done=Signal(bool(0)),
+    return dict(clk=Signal(bool(0)), rst=_rst(), start=Signal(bool(0)), enable=Signal(bool(0)), busy=Signal(bool(0)), done=Signal(bool(0)),
                 coord=CoordPair(cal.source_width, cal.source_height, poly_model.resolve_frac(cal, p["frac"])),
                 **_coef_port(p, cal))
 
@@ -136,7 +191,7 @@ def _warper_ports(p):
 BLOCKS: dict[str, BlockSpec] = {
     "line_delay": BlockSpec(
         "line_delay", "one-line FIFO in block RAM: pixel (x, y-1) at (x, y)", line_delay,
-        dict(width=352, height=288, data_width=8),
+        dict(width=352, height=288, data_width=8, stereo=False),
         sink_width=lambda p: p["data_width"], source_width=lambda p: p["data_width"],
         hw_params=("width", "height")),
     "convolve": BlockSpec(
@@ -170,17 +225,56 @@ BLOCKS: dict[str, BlockSpec] = {
     "poly_unit": BlockSpec(
         "poly_unit", "the four rectification polynomials, 8-stage pipeline, 9 multipliers, 1 coordinate/clock",
         poly_unit, _POLY_DEFAULTS,
-        hw_params=("quantizers", "frac", "source_width", "source_height"), ports=_poly_ports),
+        hw_params=("quantizers", "frac", "source_width", "source_height"), build=_build_poly_unit),
     "coordinate_warper": BlockSpec(
         "coordinate_warper", "x/y counters, poly_unit and the double-buffered coordinate pair output (4 clocks/pair)",
         coordinate_warper, _POLY_DEFAULTS,
-        hw_params=("quantizers", "frac", "source_width", "source_height"), ports=_warper_ports),
+        hw_params=("quantizers", "frac", "source_width", "source_height"), build=_build_coordinate_warper),
     "harris_mono": BlockSpec(
         "harris_mono", "Harris corners: Sobel -> window -> cornerness -> pre-threshold -> NMS", harris_mono,
         dict(width=352, height=288, blocks=(4, 4), nms=3),
         sink_width=lambda p: 8, source_width=lambda p: nms_model.WORD.width,
         hw_params=("width", "height", "blocks", "nms"),
         control=(("k", _k_port),) + _thr_ports()),
+    "stream_checker": BlockSpec(
+        "stream_checker", "protocol checker: lines/frames of the wrong size, stereo interleaving; sticky error "
+        "and fault code; optional repair (broken frames become reset tokens)", stream_checker,
+        dict(width=352, height=288, data_width=8, stereo=False, repair=False),
+        sink_width=lambda p: p["data_width"], source_width=lambda p: p["data_width"],
+        hw_params=("width", "height", "repair"),
+        control=(("error", lambda p: Signal(bool(0))),
+                 ("code", lambda p: Signal(intbv(0)[checker_model.CODE_BITS:])))),
+    "camera_stream": BlockSpec(
+        "camera_stream", "camera bus (PCLK, VSYNC, HREF, 8-bit YUV 4:2:2) to 16-bit words, whole frames only",
+        camera_stream, dict(_CAMERA, luma=True), sink_width=lambda p: 8, source_width=lambda p: CAMERA_WORD.width,
+        hw_params=tuple(_CAMERA), build=_build_camera_stream, clocks=(("cam_pclk", 18.0),)),
+    "async_fifo": BlockSpec(
+        "async_fifo", "dual-clock frame FIFO: Gray pointers, a reset per domain, broken frames dropped and counted",
+        async_fifo, dict(data_width=CAMERA_WORD.width, depth=1024), sink_width=lambda p: p["data_width"],
+        source_width=lambda p: p["data_width"], hw_params=("depth",), build=_build_async_fifo,
+        clocks=(("wclk", 18.0), ("rclk", 100.0))),
+    "camera_interface": BlockSpec(
+        "camera_interface", "camera_stream + async_fifo: a camera bus in, whole frames in the system clock out",
+        camera_interface, dict(_CAMERA, depth=1024), sink_width=lambda p: 8,
+        source_width=lambda p: CAMERA_WORD.width, hw_params=(*_CAMERA, "depth"), build=_build_camera_interface,
+        clocks=(("cam_pclk", 18.0), ("rclk", 100.0))),
+    "camera_pair": BlockSpec(
+        "camera_pair", "two camera_interfaces, each with its own camera clock, into one system clock",
+        camera_pair, dict(_CAMERA, depth=1024), sink_width=lambda p: 8, source_width=lambda p: CAMERA_WORD.width,
+        hw_params=(*_CAMERA, "depth"), build=_build_camera_pair,
+        clocks=(("cam_l_pclk", 18.0), ("cam_r_pclk", 18.0), ("rclk", 100.0))),
+    "stream_to_axis": BlockSpec(
+        "stream_to_axis", "image stream -> AXI4-Stream video (UG934), FIFO for tready, cut frames on overflow",
+        stream_to_axis, dict(width=352, height=288, data_width=8, depth=1024, commit="line"),
+        sink_width=lambda p: p["data_width"], source_width=lambda p: p["data_width"],
+        hw_params=("width", "height", "depth", "commit"), source_type=AxiStream,
+        control=(("overflow", lambda p: Signal(bool(0))),)),
+    "axis_to_stream": BlockSpec(
+        "axis_to_stream", "AXI4-Stream video (UG934) -> image stream of a fixed geometry, tokens for faults",
+        axis_to_stream, dict(width=352, height=288, data_width=8),
+        sink_width=lambda p: p["data_width"], source_width=lambda p: p["data_width"],
+        hw_params=("width", "height"), sink_type=AxiStream,
+        control=(("error", lambda p: Signal(bool(0))),)),
 }
 
 

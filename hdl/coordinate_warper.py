@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv
+from myhdl import Signal, always_comb, always_seq, block, concat, intbv
 
-from eyestereo.hdl.common.checks import check_clock, check_int, check_reset, check_signal
+from eyestereo.hdl.common.checks import block_error, check_clock, check_distinct, check_int, check_reset, check_signal
 from eyestereo.hdl.common.registers import en_reg
 from eyestereo.hdl.coord_pair import CoordPair
-from eyestereo.hdl.poly_unit import CoefPort, calibration_param, poly_unit
+from eyestereo.hdl.poly_unit import calibration_param, poly_unit
 from eyestereo.tools.models import poly_unit as unit_model
 
 __all__ = ["FIRST_PAIR", "coordinate_warper"]
@@ -104,13 +104,17 @@ def coordinate_warper(clk, rst, start, enable, busy, done, coord, coef=None, *, 
     for name, sig in (("start", start), ("enable", enable), ("busy", busy), ("done", done)):
         check_signal(name, sig, width=1)
     if not isinstance(coord, CoordPair):
-        raise ValueError(f"port coord must be a CoordPair, got {type(coord).__name__}")
+        raise block_error(f"port coord must be a CoordPair, got {type(coord).__name__}")
     if (coord.source_width, coord.source_height, coord.frac) != (cal.source_width, cal.source_height, frac):
-        raise ValueError(f"port coord is sized for {coord.source_width}x{coord.source_height} images and frac "
+        raise block_error(f"port coord is sized for {coord.source_width}x{coord.source_height} images and frac "
                          f"{coord.frac}; this warper has {cal.source_width}x{cal.source_height} and frac {frac}")
+    check_distinct(dict(busy=busy, done=done, coord_valid=coord.valid, coord_xl=coord.xl, coord_yl=coord.yl,
+                        coord_xr=coord.xr, coord_yr=coord.yr, coord_oor_l=coord.oor_l, coord_oor_r=coord.oor_r,
+                        coord_eol=coord.eol, coord_eof=coord.eof),
+                   dict(clk=clk, rst=rst, start=start, enable=enable, coord_read_ack=coord.read_ack))
     w, h = cal.width, cal.height
     if w < 2 or h < 2:
-        raise ValueError(f"parameter quantizers: the rectified image must be at least 2x2 pixels, got {w}x{h}")
+        raise block_error(f"parameter quantizers: the rectified image must be at least 2x2 pixels, got {w}x{h}")
     nb = unit_model.coord_bits(cal, frac)
     nx, ny = coord.x_format.wl, coord.y_format.wl
 

@@ -7,9 +7,9 @@ from typing import Any
 
 from myhdl import Signal, always, always_comb, always_seq, block, intbv
 
-from eyestereo.hdl.common.checks import check_choice, check_clock, check_int, check_reset, check_signal
+from eyestereo.hdl.common.checks import (block_error, check_clock, check_distinct, check_int, check_reset,
+                                         check_signal)
 from eyestereo.hdl.common.quantize import fmt_signal, fx_add, fx_mul, fx_resize
-from eyestereo.hdl.common.registers import assign
 from eyestereo.tools.fixed import Fmt, ufix
 from eyestereo.tools.models import poly_unit as model
 from eyestereo.tools.rectify.ffc import FFCError
@@ -57,20 +57,20 @@ def calibration_param(quantizers: Any, source_width: Any, source_height: Any) ->
                                     cal.formats, cal.codes, cal.origin)
     else:
         if quantizers is not None and not isinstance(quantizers, (str, os.PathLike, dict)):
-            raise ValueError(f"parameter quantizers must be a calibration spec, a quantizers.json path or "
+            raise block_error(f"parameter quantizers must be a calibration spec, a quantizers.json path or "
                              f"document, or a Calibration; got {type(quantizers).__name__}")
         try:
             cal = model.Calibration.load(quantizers, source_width=sw, source_height=sh)
         except (FFCError, ValueError, FileNotFoundError, KeyError) as exc:
-            raise ValueError(f"parameter quantizers: {exc}") from None
+            raise block_error(f"parameter quantizers: {exc}") from None
     if cal.source_width < 2 or cal.source_height < 2:
-        raise ValueError(f"parameter source_width/source_height: the camera image must be at least 2x2 "
+        raise block_error(f"parameter source_width/source_height: the camera image must be at least 2x2 "
                          f"pixels, got {cal.source_width}x{cal.source_height}")
     for i, f in enumerate(cal.formats[:10], 1):
         if f.wl > 31:
-            raise ValueError(f"parameter quantizers: q{i} {f} is wider than 31 bits (VHDL integer constants)")
+            raise block_error(f"parameter quantizers: q{i} {f} is wider than 31 bits (VHDL integer constants)")
     if cal.out_format.wl > 31:
-        raise ValueError(f"parameter quantizers: q24 {cal.out_format} is wider than 31 bits")
+        raise block_error(f"parameter quantizers: q24 {cal.out_format} is wider than 31 bits")
     return cal
 
 
@@ -200,12 +200,14 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
     check_signal("coord", coord, width=nb, signed=False)
     check_signal("out_of_range", out_of_range, width=1)
     check_signal("select_coord_out", select_coord_out, width=3, signed=False)
+    check_distinct(dict(coord=coord, out_of_range=out_of_range, select_coord_out=select_coord_out),
+                   dict(clk=clk, rst=rst, enable=enable, x=x, y=y, select_coord=select_coord))
     if coef is not None:
         if not isinstance(coef, CoefPort):
-            raise ValueError(f"port coef must be a CoefPort or None, got {type(coef).__name__}")
+            raise block_error(f"port coef must be a CoefPort or None, got {type(coef).__name__}")
         if coef.data_bits != model.coef_data_bits(fm):
-            raise ValueError(f"port coef must carry {model.coef_data_bits(fm)} data bits (the widest of "
-                             f"q1..q10), got {coef.data_bits}")
+            raise block_error(f"port coef must carry {model.coef_data_bits(fm)} data bits (the widest of "
+                              f"q1..q10), got {coef.data_bits}")
 
     def q(n: int) -> Fmt:
         return fm[n - 1]

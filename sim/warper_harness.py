@@ -24,7 +24,7 @@ The harness is registered as the simulation-only catalogue top ``coordinate_warp
 
 from __future__ import annotations
 
-from myhdl import ConcatSignal, Signal, always, always_comb, always_seq, block, concat, intbv
+from myhdl import ConcatSignal, ResetSignal, Signal, always, always_comb, always_seq, block, concat, intbv
 
 from eyestereo.hdl.catalog import BENCH_TOPS, BlockSpec, _calibration, _POLY_DEFAULTS
 from eyestereo.hdl.coord_pair import CoordPair
@@ -156,11 +156,13 @@ def coordinate_warper_tb(clk, rst, start, busy, done, ack_p, ack_reg, burst, en_
     return dut, rng_a, rng_e, seeds, consumer, taking, state, counting
 
 
-def _ports(p):
+def _build(p):
     cal = _calibration(p)
     pw = pair_bits(cal, unit_model.resolve_frac(cal, p["frac"]))
     b = p["batch"]
-    ports = dict(start=Signal(bool(0)), busy=Signal(bool(0)), done=Signal(bool(0)), ack_p=Signal(intbv(0)[9:]),
+    if b < 2:
+        raise ValueError(f"parameter batch must be at least 2, got {b}")
+    ports = dict(clk=Signal(bool(0)), rst=ResetSignal(0, active=1, isasync=False), start=Signal(bool(0)), busy=Signal(bool(0)), done=Signal(bool(0)), ack_p=Signal(intbv(0)[9:]),
                  ack_reg=Signal(bool(0)), burst=Signal(bool(0)), en_p=Signal(intbv(0)[9:]),
                  seed=Signal(intbv(0)[32:]), rec_strobe=Signal(bool(0)), rec_data=Signal(intbv(0)[b * pw:]),
                  rec_shift=Signal(intbv(0)[b * pw:]), rec_count=Signal(intbv(0, min=0, max=b)),
@@ -173,5 +175,5 @@ def _ports(p):
 
 SPEC = BlockSpec(NAME, "bench harness: coordinate_warper with an LFSR consumer and a batching recorder",
                  coordinate_warper_tb, dict(_POLY_DEFAULTS, batch=16),
-                 hw_params=("quantizers", "frac", "source_width", "source_height", "batch"), ports=_ports)
+                 hw_params=("quantizers", "frac", "source_width", "source_height", "batch"), build=_build)
 BENCH_TOPS[NAME] = SPEC

@@ -38,24 +38,28 @@ def test_poly_unit_elaborates(cal):
 
 @pytest.mark.parametrize("over,match", [
     (dict(rst=Signal(bool(0))), "port rst"),
-    (dict(x=Signal(intbv(0)[9:])), "port x must be 6 bits"),
+    (dict(x=Signal(intbv(0)[9:])), "port x must be 6 bits wide"),
     (dict(y=Signal(intbv(0, min=-16, max=16))), "port y must be unsigned"),
-    (dict(select_coord=Signal(intbv(0)[2:])), "port select_coord must be 3 bits"),
-    (dict(coord=Signal(intbv(0)[20:])), "port coord must be 14 bits"),
-    (dict(enable=Signal(intbv(0)[2:])), "port enable must be 1 bits"),
+    (dict(select_coord=Signal(intbv(0)[2:])), "port select_coord must be 3 bits wide"),
+    (dict(coord=Signal(intbv(0)[20:])), "port coord must be 14 bits wide"),
+    (dict(enable=Signal(intbv(0)[2:])), "port enable must be 1 bit wide"),
     (dict(coef=CoefPort(3)), "port coef must carry"),
     (dict(coef=Signal(bool(0))), "port coef must be a CoefPort"),
+    (dict(out_of_range="shared"), "ports out_of_range and enable share a signal"),
 ])
 def test_poly_unit_rejects_ports(cal, over, match):
+    if over.get("out_of_range") == "shared":
+        enable = Signal(bool(0))
+        over = dict(enable=enable, out_of_range=enable)
     with pytest.raises(ValueError, match=match):
         build_unit(cal, **over)
 
 
 @pytest.mark.parametrize("params,match", [
     (dict(frac=-1), "frac"), (dict(frac=2.0), "frac"), (dict(frac=17), "frac"),
-    (dict(quantizers="nope"), "parameter quantizers: unknown calibration spec"),
+    (dict(quantizers="nope"), "poly_unit: parameter quantizers: unknown calibration spec"),
     (dict(quantizers=42), "parameter quantizers must be"),
-    (dict(quantizers="/no/such/quantizers.json"), "parameter quantizers: .*no such file"),
+    (dict(quantizers="/no/such/quantizers.json"), "parameter quantizers: .*does not exist"),
     (dict(source_width=1), "source_width"),
     (dict(source_height=2.5), "source_height"),
 ])
@@ -81,7 +85,7 @@ def test_warper_elaborates_and_checks(cal):
         coordinate_warper(*warper_ports(cal, coord=CoordPair(352, 288, 4)).values(), quantizers=cal, frac=5)
     with pytest.raises(ValueError, match="port coord must be a CoordPair"):
         coordinate_warper(*warper_ports(cal, coord=Signal(bool(0))).values(), quantizers=cal, frac=5)
-    with pytest.raises(ValueError, match="port start must be 1 bits"):
+    with pytest.raises(ValueError, match="coordinate_warper: port start must be 1 bit wide"):
         coordinate_warper(*warper_ports(cal, start=Signal(intbv(0)[2:])).values(), quantizers=cal, frac=5)
 
 
@@ -102,12 +106,14 @@ def test_catalogue_entries(cal):
     # (the default configurations are elaborated by test_params.py)
     for name in ("poly_unit", "coordinate_warper"):
         spec = BLOCKS[name]
-        assert not spec.is_stream and spec.params()["quantizers"] == "rig"
-        assert "coef" not in spec.ports(spec.params(quantizers=SPEC))
-        ports = spec.ports(spec.params(quantizers=SPEC, coefficients="register", frac=3))
+        assert spec.build is not None and spec.params()["quantizers"] == "rig"
+        ports, kw, _ = spec.ports(quantizers=SPEC)
+        assert "coef" not in ports and list(ports)[:2] == ["clk", "rst"] and kw["quantizers"] == SPEC
+        ports, _, _ = spec.ports(quantizers=SPEC, coefficients="register", frac=3)
         assert ports["coef"].data_bits == unit.coef_data_bits(cal.formats)
         with pytest.raises(ValueError, match="coefficients must be"):
             spec.elaborate(quantizers=SPEC, coefficients="rom")
     _, ports, _ = BLOCKS["coordinate_warper"].elaborate(quantizers=SPEC, coefficients="register")
     assert ports["coord"].frac == unit.resolve_frac(cal) and ports["coord"].source_width == 352
     assert len(ports["coord"].xl) == unit.int_bits(352) + unit.resolve_frac(cal)
+    assert list(ports) == ["clk", "rst", "start", "enable", "busy", "done", "coord", "coef"]

@@ -179,7 +179,7 @@ def test_calibration_specs_refused(spec, match):
 
 
 def test_calibration_file_errors(tmp_path):
-    with pytest.raises(ValueError, match="no such file"):
+    with pytest.raises(ValueError, match="does not exist"):
         calibrations.load(tmp_path / "missing.json")
     (tmp_path / "bad.json").write_text("{")
     with pytest.raises(ValueError, match="not valid JSON"):

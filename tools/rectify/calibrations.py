@@ -30,8 +30,9 @@ for a file without them the rectified size is used), ``origin`` (the spec) and `
 (the fitted polynomials before the conversion, for error studies).
 
 Built documents are cached as JSON under ``build/cache/quantizers/`` of the repository (or
-``$EYESTEREO_CACHE``, else ``~/.cache/eyestereo``), keyed by the spec, the generator version and a hash
-of the polynomials, and written atomically, so parallel test workers may build the same one.
+``$EYESTEREO_CACHE``, else ``~/.cache/eyestereo``), keyed by the spec, the generator version, the
+polynomials and the source of the float-to-fixed conversion, and written atomically, so parallel test
+workers may build the same one.
 """
 
 from __future__ import annotations
@@ -201,7 +202,11 @@ def _build(spec: str, kind: str, args: dict[str, Any]) -> dict[str, Any]:
                                                          source_height=sh)) + "\n")
     else:
         polys, w, h, sw, sh = _polynomials(kind, args)
-    key_src = json.dumps([GENERATOR_VERSION, spec, w, h, sw, sh, polys], sort_keys=True)
+    # The key holds the float-to-fixed conversion's own source: a changed FFC rebuilds every entry.
+    from eyestereo.tools.rectify import ffc
+
+    ffc_src = hashlib.sha256(Path(ffc.__file__).read_bytes()).hexdigest()
+    key_src = json.dumps([GENERATOR_VERSION, spec, w, h, sw, sh, polys, ffc_src], sort_keys=True)
     digest = hashlib.sha256(key_src.encode()).hexdigest()[:16]
     path = folder / f"{_cache_name(spec)}.{digest}.quantizers.json"
     if path.exists():
