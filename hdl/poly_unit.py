@@ -10,6 +10,7 @@ from myhdl import Signal, always, always_comb, always_seq, block, intbv
 from eyestereo.hdl.common.checks import (block_error, check_clock, check_distinct, check_int, check_reset,
                                          check_signal)
 from eyestereo.hdl.common.quantize import fmt_signal, fx_add, fx_mul, fx_resize
+from eyestereo.hdl.common.registers import assign
 from eyestereo.tools.fixed import Fmt, ufix
 from eyestereo.tools.models import poly_unit as model
 from eyestereo.tools.rectify.ffc import FFCError
@@ -87,18 +88,21 @@ def coef_rom(index, out, codes: tuple[int, ...]):
 
 @block
 def coef_ram(clk, index, out, coef, number: int, codes: tuple[int, ...]):
-    """A 4-entry coefficient memory: written through ``coef`` at addresses 4 * number + 0..3, read by
-    ``index`` (asynchronous read: LUT-RAM); starts with ``codes``."""
+    """A coefficient memory: written through ``coef`` at addresses 4 * number + 0..3, read by ``index``
+    (asynchronous read); starts with ``codes``. It is 16 words deep (12 never used): the depth of a
+    Spartan-3E LUT-RAM (RAM16X1S), so synthesis maps it to one LUT-RAM per bit instead of flip-flops."""
     wl = len(out)
-    mem = [Signal(intbv(c)[wl:]) for c in codes]
+    mem = [Signal(intbv(c)[wl:]) for c in codes] + [Signal(intbv(0)[wl:]) for _ in range(12)]
     word = Signal(intbv(0)[wl:])
-    slot = Signal(intbv(0)[2:])
+    slot = Signal(intbv(0)[4:])
+    raddr = Signal(intbv(0)[4:])
     hit = Signal(bool(0))
 
     @always_comb
     def decode():
         word.next = coef.data[wl:]
         slot.next = coef.addr[2:]
+        raddr.next = index
         hit.next = coef.we and coef.addr[6:2] == number
 
     @always(clk.posedge)
@@ -108,7 +112,7 @@ def coef_ram(clk, index, out, coef, number: int, codes: tuple[int, ...]):
 
     @always_comb
     def read():
-        out.next = mem[index]
+        out.next = mem[raddr]
 
     return decode, write, read
 
@@ -139,18 +143,19 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
 
     Pipeline (every register takes its input only when ``enable`` is high)::
 
-        stage  registers                                      coefficients selected for the next stage
-        A      X = q25(x), Y = q26(y), select                 p8 p10 p7 p9 (by the input select)
-        B      q11 = p8 Y, q12 = p10 X, q13 = p7 X, q14 = p9 Y  p5 p4
-        C      q20 = p5 + q11 + q12, q21 = p4 + q13 + q14     p6
-        D      q15 = q20 Y, q16 = p6 X, q17 = q21 X           p3 p2
-        E      q22 = q15 + p3 + q16, q23 = q17 + p2
-        F      q18 = q22 Y, q19 = q23 X                       p1
-        G      q24 = p1 + q18 + q19
+        stage  registers                                        coefficients (of the polynomial in flight)
+        A      X = q25(x), Y = q26(y), select_coord             p8 p10 p7 p9 registered here
+        B      q11 = p8 Y, q12 = p10 X, q13 = p7 X, q14 = p9 Y  p6 registered here
+        C      q20 = p5 + q11 + q12, q21 = p4 + q13 + q14       p5 p4 into the adders
+        D      q15 = q20 Y, q16 = p6 X, q17 = q21 X
+        E      q22 = q15 + p3 + q16, q23 = q17 + p2             p3 p2 into the adders
+        F      q18 = q22 Y, q19 = q23 X
+        G      q24 = p1 + q18 + q19                             p1 into the adder
         H      coord = q24 cut to frac bits, out_of_range, select_coord_out
 
-    The coefficients of a stage are selected by the select code one stage earlier and registered, so
-    every multiplier takes both operands straight from registers.
+    The multipliers' coefficients are chosen by the select code one stage ahead and registered, so every
+    multiplier takes both operands straight from registers; the addends p1..p5 are chosen in the stage
+    that adds them, where the 4-entry table and the adder's first level share LUTs.
 
     Ports:
         clk, rst: clock; synchronous active-high reset (clears the valid bits of the pipeline only).
@@ -216,9 +221,9 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
 
     # --- select pipeline (valid bits reset) and the coefficient index of each stage
     sels = {s: Signal(intbv(0)[3:]) for s in "ABCDEFG"}
-    idx = {s: Signal(intbv(0)[2:]) for s in ("in", "A", "B", "C", "E")}
+    idx = {s: Signal(intbv(0)[2:]) for s in ("in", "A", "B", "D", "F")}
     insts.append(low2(select_coord, idx["in"]))
-    for s in "ABCE":
+    for s in "ABDF":
         insts.append(low2(sels[s], idx[s]))
     sa, sb, sc, sd, se, sf, sg = (sels[s] for s in "ABCDEFG")
 
@@ -237,13 +242,19 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
     insts.append(select_pipe)
 
     # --- coefficients: p_i of the four polynomials, chosen by the select code one stage ahead
-    chooser = {8: "in", 10: "in", 7: "in", 9: "in", 5: "A", 4: "A", 6: "B", 3: "C", 2: "C", 1: "E"}
+    # Multiplier operands are registered (chosen one stage ahead), so each multiplier takes both operands
+    # from registers; the addends of the sums are chosen in their own stage and go straight into the
+    # adder, where the table and the adder's first level share LUTs.
+    chooser = {8: "in", 10: "in", 7: "in", 9: "in", 6: "B", 5: "B", 4: "B", 3: "D", 2: "D", 1: "F"}
+    registered = (8, 10, 7, 9, 6)
     cbits, creg = {}, {}
     for i, where in chooser.items():
         f = q(i)
         codes = tuple(cal.codes[k][i - 1] & ((1 << f.wl) - 1) for k in range(4))
         cbits[i] = Signal(intbv(0)[f.wl:])
         creg[i] = fmt_signal(f)
+        if i not in registered:
+            insts.append(assign(cbits[i], creg[i]))  # reinterpretation only
         if coef is None:
             insts.append(coef_rom(idx[where], cbits[i], codes))
         else:
@@ -321,8 +332,6 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
             r14.next = n14
             xb.next = xa
             yb.next = ya
-            c5.next = b5
-            c4.next = b4
             # C
             r20.next = n20
             r21.next = n21
@@ -335,8 +344,6 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
             r17.next = n17
             xd.next = xc
             yd.next = yc
-            c3.next = b3
-            c2.next = b2
             # E
             r22.next = n22
             r23.next = n23
@@ -345,7 +352,6 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
             # F
             r18.next = n18
             r19.next = n19
-            c1.next = b1
             # G
             r24.next = n24
             # H

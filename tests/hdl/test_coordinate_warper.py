@@ -70,3 +70,17 @@ def test_warper_full_frame_default_calibration(request):
     rep = _run(request, dict(quantizers="rig", batch=32), frames=1, seed=12)
     assert rep["clocks_per_pair"] == 4.0
     assert rep["oor_l"] > 0 and rep["oor_r"] > 0
+
+
+def test_warper_netlist(request):
+    """GHDL's netlist of the VHDL (harness and warper; what make synth measures of the warper), in
+    Icarus: every pair of two frames, random consumer pulses and random enable."""
+    import shutil
+
+    from eyestereo.sim.netlist import run_netlist_bench
+
+    if shutil.which("iverilog") is None:
+        pytest.skip("Icarus Verilog not installed")
+    rep = run_netlist_bench(TOP, "tb_coordinate_warper", dict(frames=2, seed=13, ack_p=100, ack_reg=True, en_p=220),
+                            name=request.node.name, params=dict(quantizers="seed:13:2@40x20", batch=8))
+    assert rep["pairs"] == 2 * 40 * 20 and rep["oor_l"] > 0

@@ -69,3 +69,18 @@ def test_poly_unit_any_quantizers_json(request, tmp_path, seed):
     path = tmp_path / f"random{seed}.quantizers.json"
     random_quantizers(path, seed)
     _run(request, dict(quantizers=str(path), frac=seed + 2), cycles=1000, seed=seed, en_p=0.9)
+
+
+@pytest.mark.parametrize("spec,coefficients", [("seed:2:3@40x20", "constant"), ("seed:4@40x20", "register")])
+def test_poly_unit_netlist(request, spec, coefficients):
+    """GHDL's netlist of the VHDL (what make synth measures), in Icarus, against the same model."""
+    import shutil
+
+    from eyestereo.sim.netlist import run_netlist_bench
+
+    if shutil.which("iverilog") is None:
+        pytest.skip("Icarus Verilog not installed")
+    cfg = dict(cycles=1200, seed=7, en_p=0.8, **({"coefficients": "random"} if coefficients == "register" else {}))
+    rep = run_netlist_bench("poly_unit", "tb_poly_unit", cfg, name=request.node.name,
+                            params=dict(quantizers=spec, coefficients=coefficients))
+    assert rep["compared"] > 0 and rep["valid"] > 0
