@@ -11,10 +11,10 @@ Measured here, by running the GHDL bench (:mod:`eyestereo.sim.tb_coordinate_warp
   stops), and the clocks from ``start`` to ``done``;
 * **simulation speed**: simulated clocks per second of the bench run (conversion, elaboration and the
   FFC of an uncached calibration excluded);
-* **the Verilog conversion** (the netlist Yosys synthesizes) on Icarus Verilog: the same bench, one full
-  frame of the default calibration;
-* **resources**: :func:`eyestereo.hdl.synth.synth_block` (MyHDL's Verilog through Yosys
-  ``synth_xilinx -family xc3se``) beside the thesis's Table 4.4.
+* **the netlist** that is measured (GHDL's synthesis of the VHDL, :mod:`eyestereo.sim.netlist`) on Icarus
+  Verilog: the same bench, one full frame of the default calibration;
+* **resources** and **fmax**: :func:`eyestereo.hdl.synth.synth_block` (that netlist through Yosys
+  ``synth_xilinx -family xc3se``; ``nextpnr-ecp5`` for fmax) beside the thesis's Table 4.4.
 
 Writes the section between ``<!-- warper-bench:begin -->`` and ``<!-- warper-bench:end -->`` of
 ``docs/rectifier.md`` (``--no-write``: print only; ``--quick``: the default calibration only).
@@ -24,18 +24,16 @@ GHDL's back end: ``$GHDL_BACKEND`` (``llvm`` if ``ghdl-llvm`` is installed), els
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import re
 import shutil
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 import eyestereo.sim.warper_harness  # noqa: F401  (registers the bench top)
 from eyestereo.hdl import synth
-from eyestereo.sim.runner import BUILD, ROOT, SIM_DIR, _jsonable, run_bench, slug
+from eyestereo.sim.runner import BUILD, ROOT, run_bench, slug
 from eyestereo.tools.rectify import calibrations
 from eyestereo.tools.rectify.ffc import atomic_write_text
 
@@ -77,33 +75,17 @@ def full_frame(label: str, spec: str, consumer: dict) -> dict:
     return dict(label=label, spec=spec, consumer=consumer, wall=wall, sim=sim_s, **rep)
 
 
-def icarus_frame(spec: str = "rig") -> dict:
-    """One full frame of the bench on Icarus Verilog (MyHDL's Verilog of the harness and the warper)."""
-    from cocotb_tools.runner import get_results, get_runner
-
-    from eyestereo.hdl.convert import convert
+def netlist_frame(spec: str = "rig") -> dict:
+    """One full frame of the bench on GHDL's netlist of the VHDL (harness and warper), in Icarus Verilog:
+    the netlist whose resources are measured below, shown bit-exact."""
+    from eyestereo.sim.netlist import run_netlist_bench
 
     if shutil.which("iverilog") is None:
         return dict(skipped="iverilog not installed")
-    d = BUILD / TOP / f"bench_icarus_{slug(spec)}"
-    shutil.rmtree(d, ignore_errors=True)
-    d.mkdir(parents=True)
-    params = dict(quantizers=spec, batch=32)
-    srcs = convert(TOP, d, hdl="Verilog", **params)
-    cfg = dict(frames=1, seed=1, ack_p=256, block=TOP, params=_jsonable(params), report=str(d / "report.json"))
-    runner = get_runner("icarus")
-    runner.build(sources=[str(s) for s in srcs], hdl_toplevel=TOP, build_dir=d, always=True,
-                 timescale=("1ns", "1ps"))
-    env = {"EYESTEREO_TB": json.dumps(cfg),
-           "PYTHONPATH": os.pathsep.join([str(SIM_DIR), os.environ.get("PYTHONPATH", "")])}
     t0 = time.perf_counter()
-    results = runner.test(hdl_toplevel=TOP, hdl_toplevel_lang="verilog", test_module="eyestereo.sim.tb_coordinate_warper",
-                          build_dir=d, test_dir=d, extra_env=env)
-    wall = time.perf_counter() - t0
-    n, failed = get_results(results)
-    if n == 0 or failed:
-        raise AssertionError(f"the Icarus run failed (see {d})")
-    return dict(json.loads((d / "report.json").read_text()), wall=wall)
+    rep = run_netlist_bench(TOP, "tb_coordinate_warper", dict(frames=1, seed=1, ack_p=256),
+                            name=f"bench_netlist_{slug(spec)}", params=dict(quantizers=spec, batch=32))
+    return dict(rep, wall=time.perf_counter() - t0)
 
 
 def resources() -> list[dict]:
@@ -114,7 +96,7 @@ def resources() -> list[dict]:
                                  ("coordinate_warper, OpenCV 640x480", "coordinate_warper", dict(quantizers="opencv"))]:
         print(f"bench_warper: synthesizing {label} ...", flush=True)
         try:
-            out.append(synth.synth_block(block, BUILD.parent / "synth_warper", label=label, **params))
+            out.append(synth.synth_block(block, BUILD.parent / "synth_warper", label=label, pnr=True, **params))
         except FileNotFoundError as exc:
             print(f"skipped {label}: {exc}", file=sys.stderr)
     return out
@@ -140,27 +122,31 @@ def report(frames: list[dict], icarus: dict | None, res: list[dict], backend: st
                      "pair** (goal 4.0): the unit never stops; a frame takes 4 x width x height + 10 clocks.")
     if icarus:
         if "skipped" in icarus:
-            lines.append(f"Icarus Verilog: skipped ({icarus['skipped']}).")
+            lines.append(f"Netlist: skipped ({icarus['skipped']}).")
         else:
-            lines.append(f"Icarus Verilog, MyHDL's Verilog of the same design (what Yosys synthesizes): one full frame of "
-                         f"the synthetic rig, {icarus['pairs']:,} pairs bit-exact, {icarus['clocks_per_pair']:.4f} clocks "
-                         f"per pair, {icarus['wall']:.0f} s.")
-    lines += ["", "Resources (Yosys `synth_xilinx -family xc3se` of MyHDL's Verilog, default configuration unless "
-              "named; LUT = 4-input LUTs, carry cells not counted):", "",
-              "| block | LUT | FF | LUT-RAM | MULT18X18 | thesis Table 4.4 (ISE, post-PAR): MULT / LUT |",
-              "|---|---:|---:|---:|---:|---|"]
-    by = {r["label"]: r["summary"] for r in res}
+            lines.append(f"GHDL's netlist of the VHDL (harness and warper; the netlist whose resources follow), in "
+                         f"Icarus Verilog: one full frame of the synthetic rig, {icarus['pairs']:,} pairs bit-exact, "
+                         f"{icarus['clocks_per_pair']:.4f} clocks per pair ({icarus['wall']:.0f} s).")
+    lines += ["", "Resources of GHDL's netlist of the VHDL (`eyestereo.hdl.synth`: `ghdl synth`, repaired, Yosys "
+              "`synth_xilinx -family xc3se`; LUT = 4-input LUTs, carry cells not counted) and fmax of the same "
+              "netlist placed and routed on an ECP5 (`nextpnr-ecp5`; the Spartan-3E has no open place and route: "
+              "the figure says how deep the logic is, the thesis's goal is 100 MHz):", "",
+              "| block | LUT | FF | LUT-RAM | MULT18X18 | fmax ECP5 (MHz) | thesis Table 4.4 (ISE, post-PAR): MULT / LUT |",
+              "|---|---:|---:|---:|---:|---:|---|"]
     for r in res:
         s = r["summary"]
         th = {"poly_unit": "calculation unit: 9 / 262",
-              "coordinate_warper": "calculation unit + warper: 9 / 361"}.get(r["label"], "-")
-        lines.append(f"| {r['label']} | {s['LUT']} | {s['FF']} | {s['LUTRAM']} | {s['MULT18X18']} | {th} |")
+              "coordinate_warper": "calculation unit + warper: 9 / 262 + 99 = 361"}.get(r["label"], "-")
+        fmax = ", ".join(f"{v['achieved']:.1f}" for v in (r.get("fmax") or {}).values()) or "-"
+        lines.append(f"| {r['label']} | {s['LUT']} | {s['FF']} | {s['LUTRAM']} | {s['MULT18X18']} | {fmax} | {th} |")
+    by = {r["label"]: r["summary"] for r in res}
     if "poly_unit" in by and "coordinate_warper" in by:
-        d = {k: by["coordinate_warper"][k] - by["poly_unit"][k] for k in ("LUT", "FF", "MULT18X18")}
-        lines += ["", f"The warper around the unit (difference of the two rows): {d['LUT']} LUTs, {d['FF']} FFs, "
-                  f"{d['MULT18X18']} multipliers (thesis: 99 LUTs, 0 multipliers). Yosys optimizes the unit "
-                  "inside the warper further than on its own (its inputs come from counters), so the difference "
-                  "understates the warper's own logic."]
+        u, w = by["poly_unit"]["LUT"], by["coordinate_warper"]["LUT"]
+        lines += ["", f"Against the thesis: the unit alone {u} LUTs ({100 * (u / 262 - 1):+.0f} % against its 262), "
+                  f"the whole warper with its unit {w} LUTs ({100 * (w / 361 - 1):+.0f} % against 262 + 99). MyHDL "
+                  "flattens the warper and its unit into one netlist, so the warper's own share is not separable "
+                  "(Yosys optimizes the unit inside the warper, whose inputs come from counters, differently from "
+                  "the unit on its own). Multipliers beyond 9: operands above 18 bits, below."]
     wide = []
     for spec in ("rig", "opencv"):
         try:
@@ -196,8 +182,8 @@ def main(argv=None) -> int:
             frames.append(full_frame(label, spec, consumer))
         except FileNotFoundError as exc:
             print(f"skipped {label}: {exc}", file=sys.stderr)
-    print("bench_warper: Icarus ...", flush=True)
-    icarus = None if args.quick else icarus_frame()
+    print("bench_warper: the netlist on Icarus ...", flush=True)
+    icarus = None if args.quick else netlist_frame()
     text = report(frames, icarus, resources(), backend)
     sys.stdout.write(text)
     if not args.no_write:

@@ -26,7 +26,6 @@ Writes the section between ``<!-- warper-precision:begin -->`` and ``<!-- warper
 from __future__ import annotations
 
 import argparse
-import os
 import re
 import sys
 import time
