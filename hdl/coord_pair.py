@@ -38,7 +38,7 @@ complete meanwhile and held in R1 while the unit stops (``enable cu`` low, the u
 at its output); the take of P2 moves P3 up at once (``valid`` stays high with new data), the unit resumes
 one clock later, and P3 is taken at once::
 
-    clock      0   1   2   3   4   5   6   7   8   9  10  11  12  13  14  15  16  17  18  19
+    cycle      0   1   2   3   4   5   6   7   8   9  10  11  12  13  14  15  16  17  18  19
     unit out  YR0 XL1 YL1 XR1 YR1 XL2 YL2 XR2 YR2 XL3 YL3 XR3 YR3 XL4 XL4 XL4 YL4 XR4 YR4 XL5
     enable cu  #   #   #   #   #   #   #   #   #   #   #   #   #   _   _   #   #   #   #   #
     valid      _   #   _   _   _   #   _   _   _   #   #   #   #   #   #   #   _   _   _   #

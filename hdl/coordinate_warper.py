@@ -53,7 +53,7 @@ def coordinate_warper(clk, rst, start, enable, busy, done, coord, coef=None, *, 
     The handshake, with a timing diagram (pairs taken at once, after a wait, and the stall of the
     unit), is documented in :mod:`eyestereo.hdl.coord_pair`::
 
-        clock      0   1   2   3   4   5   6   7   8   9  10  11  12  13  14  15  16  17  18  19
+        cycle      0   1   2   3   4   5   6   7   8   9  10  11  12  13  14  15  16  17  18  19
         unit out  YR0 XL1 YL1 XR1 YR1 XL2 YL2 XR2 YR2 XL3 YL3 XR3 YR3 XL4 XL4 XL4 YL4 XR4 YR4 XL5
         enable cu  #   #   #   #   #   #   #   #   #   #   #   #   #   _   _   #   #   #   #   #
         valid      _   #   _   _   _   #   _   _   _   #   #   #   #   #   #   #   _   _   _   #
@@ -64,7 +64,7 @@ def coordinate_warper(clk, rst, start, enable, busy, done, coord, coef=None, *, 
     from the next clock until the frame's last pair (``eof``) has been taken; ``done`` is high for the one
     clock after that take (``busy`` low again; a ``start`` in that clock begins the next frame)::
 
-        clock     s   s+1  ...  s+13 ...    e   e+1
+        cycle     s   s+1  ...  s+13 ...    e   e+1
         start     #    _         _          _    .
         busy      _    #    #    #    #     #    _
         valid     _    _    _    #   ...    #    .      (first pair in clock s + 13; last pair: eof)
