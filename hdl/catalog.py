@@ -20,6 +20,8 @@ from eyestereo.hdl.nms import nms
 from eyestereo.hdl.prethreshold import prethreshold
 from eyestereo.hdl.line_delay import line_delay
 from eyestereo.hdl.sobel import sobel
+from eyestereo.hdl.sram_bus import SramCmd, SramPins, SramRsp
+from eyestereo.hdl.sram_controller import sram_controller
 from eyestereo.hdl.stream import ImageStream
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import harris_window as window_model
@@ -34,11 +36,14 @@ class BlockSpec:
     summary: str
     func: Callable
     defaults: dict
-    sink_width: Callable[[dict], int]
-    source_width: Callable[[dict], int]
+    sink_width: Callable[[dict], int] | None = None
+    source_width: Callable[[dict], int] | None = None
     hw_params: tuple[str, ...] = field(default=())  # parameters passed to the block function
     #: control ports after ``source``, in order: name -> function(params) -> fresh Signal
     control: tuple[tuple[str, Callable[[dict], object]], ...] = field(default=())
+    #: blocks whose ports are not ``clk, rst, sink, source, control...``: function(params) -> ordered dict
+    #: of every port (name -> fresh Signal or interface), passed to the block positionally in that order
+    ports: Callable[[dict], dict] | None = None
 
     def params(self, **overrides) -> dict:
         unknown = set(overrides) - set(self.defaults)
@@ -51,6 +56,10 @@ class BlockSpec:
     def elaborate(self, **overrides):
         """(instance, ports dict) of a fresh instance with the given parameters."""
         p = self.params(**overrides)
+        if self.ports is not None:
+            ports = self.ports(p)
+            kw = {k: v for k, v in p.items() if k in self.hw_params}
+            return self.func(*ports.values(), **kw), ports, p
         clk = Signal(bool(0))
         rst = ResetSignal(0, active=1, isasync=False)
         sink = ImageStream(self.sink_width(p))
@@ -123,6 +132,21 @@ BLOCKS: dict[str, BlockSpec] = {
         hw_params=("width", "height", "blocks", "nms"),
         control=(("k", _k_port),) + _thr_ports()),
 }
+
+
+def _clk_rst():
+    return dict(clk=Signal(bool(0)), rst=ResetSignal(0, active=1, isasync=False))
+
+
+def _sram_controller_ports(p):
+    return dict(_clk_rst(), cmd=SramCmd(tag_bits=p["tag_bits"]), rsp=SramRsp(tag_bits=p["tag_bits"]),
+                sram=SramPins())
+
+
+BLOCKS["sram_controller"] = BlockSpec(
+    "sram_controller", "1M x 16 synchronous SRAM (NoBL or pipelined SyncBurst): pins <-> in-order word port",
+    sram_controller, dict(kind="nobl", read_latency=2, tag_bits=5),
+    hw_params=("kind", "read_latency"), ports=_sram_controller_ports)
 
 
 def get(name: str) -> BlockSpec:
