@@ -20,8 +20,13 @@ from eyestereo.hdl.nms import nms
 from eyestereo.hdl.prethreshold import prethreshold
 from eyestereo.hdl.line_delay import line_delay
 from eyestereo.hdl.sobel import sobel
-from eyestereo.hdl.sram_bus import SramCmd, SramPins, SramRsp
+from eyestereo.hdl.fetch_port import FetchPort
+from eyestereo.hdl.frame_buffers import FrameControl
+from eyestereo.hdl.queue_port import QueuePort
+from eyestereo.hdl.sram_arbiter import TAG_BITS, sram_arbiter
+from eyestereo.hdl.sram_bus import HostPort, SramCmd, SramPins, SramRsp, StatPort
 from eyestereo.hdl.sram_controller import sram_controller
+from eyestereo.hdl.sram_subsystem import sram_subsystem
 from eyestereo.hdl.stream import ImageStream
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import harris_window as window_model
@@ -147,6 +152,26 @@ BLOCKS["sram_controller"] = BlockSpec(
     "sram_controller", "1M x 16 synchronous SRAM (NoBL or pipelined SyncBurst): pins <-> in-order word port",
     sram_controller, dict(kind="nobl", read_latency=2, tag_bits=5),
     hw_params=("kind", "read_latency"), ports=_sram_controller_ports)
+
+
+def _masters(p):
+    return dict(cam0=QueuePort(16), cam1=QueuePort(16), fetch=FetchPort(p["width"], p["height"]),
+                rect=ImageStream(8, stereo=True), feat=QueuePort(16), host=HostPort(), ctl=FrameControl(),
+                stat=StatPort())
+
+
+_ARB = dict(width=352, height=288, feature_words=8192, depth=16, burst=8, fetch_burst=8, host_burst=2,
+            counter_bits=32)
+
+BLOCKS["sram_arbiter"] = BlockSpec(
+    "sram_arbiter", "six SRAM masters (2 cameras, fetch port, rectified, features, host), double buffers",
+    sram_arbiter, dict(_ARB), hw_params=tuple(_ARB),
+    ports=lambda p: dict(_clk_rst(), **_masters(p), cmd=SramCmd(tag_bits=TAG_BITS), rsp=SramRsp(tag_bits=TAG_BITS)))
+
+BLOCKS["sram_subsystem"] = BlockSpec(
+    "sram_subsystem", "sram_arbiter + sram_controller: the SRAM's pins and the six masters' ports",
+    sram_subsystem, dict(_ARB, kind="nobl", read_latency=2), hw_params=tuple(_ARB) + ("kind", "read_latency"),
+    ports=lambda p: dict(_clk_rst(), **_masters(p), sram=SramPins()))
 
 
 def get(name: str) -> BlockSpec:

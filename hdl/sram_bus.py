@@ -65,7 +65,7 @@ from myhdl import Signal, intbv
 
 from eyestereo.tools.sram import ADDR_BITS, DATA_BITS
 
-__all__ = ["SramPins", "SramCmd", "SramRsp"]
+__all__ = ["SramPins", "SramCmd", "SramRsp", "HostPort", "StatPort"]
 
 
 def _bits(name: str, value, lo: int, hi: int) -> int:
@@ -128,3 +128,61 @@ class SramRsp:
 
     def fields(self) -> list[str]:
         return ["valid", "data", "tag"]
+
+
+class HostPort:
+    """The host's word port into the SRAM (the processor bus bridge of the complete system is its master).
+
+    Fields (ports ``<arg>_<field>``)::
+
+        req_valid  in   a request is offered, held until it moves
+        req_ready  out  the arbiter takes it (it moves on a rising edge with req_valid & req_ready)
+        req_we     in   1 write, 0 read
+        req_addr   in   20-bit word address (the whole SRAM; the frame buffers' map is
+                        eyestereo.tools.models.sram_arbiter.AddressMap)
+        req_wdata  in   16 bits
+        req_be     in   2 bits, the bytes a write changes (bit 1: 15..8, bit 0: 7..0)
+        rsp_valid  out  one clock per read, in request order, no back-pressure
+        rsp_data   out  the word read
+
+    Writes are posted (no response); a read after a write to the same address returns the written word.
+    The arbiter takes one request per two clocks at most (``req_ready`` comes from a register)::
+
+        cycle      0    1    2    3    4 ...    n
+        req_valid  #    #    #    _    _        _
+        req_ready  #    _    #    _    #        #
+        req_we     _    #    #    .    .        .
+        rsp_valid  _    _    _    _    _        #     the read of cycle 0; n depends on the load
+    """
+
+    def __init__(self, addr_bits: int = ADDR_BITS, data_bits: int = DATA_BITS):
+        self.addr_bits = _bits("HostPort addr_bits", addr_bits, 1, 24)
+        self.data_bits = _bits("HostPort data_bits", data_bits, 8, 32)
+        self.req_valid = Signal(bool(0))
+        self.req_ready = Signal(bool(0))
+        self.req_we = Signal(bool(0))
+        self.req_addr = Signal(intbv(0)[self.addr_bits:])
+        self.req_wdata = Signal(intbv(0)[self.data_bits:])
+        self.req_be = Signal(intbv(0)[self.data_bits // 8:])
+        self.rsp_valid = Signal(bool(0))
+        self.rsp_data = Signal(intbv(0)[self.data_bits:])
+
+    def fields(self) -> list[str]:
+        return ["req_valid", "req_ready", "req_we", "req_addr", "req_wdata", "req_be", "rsp_valid", "rsp_data"]
+
+
+class StatPort:
+    """Read port of the arbiter's counters and frame-buffer status: ``addr`` in, ``data`` (32 bits) out
+    one clock later (a registered multiplexer; the register map is the arbiter's docstring)::
+
+        cycle  0    1    2
+        addr   a0   a1   .
+        data   .    d0   d1
+    """
+
+    def __init__(self, addr_bits: int = 5, data_bits: int = 32):
+        self.addr = Signal(intbv(0)[_bits("StatPort addr_bits", addr_bits, 1, 8):])
+        self.data = Signal(intbv(0)[_bits("StatPort data_bits", data_bits, 16, 64):])
+
+    def fields(self) -> list[str]:
+        return ["addr", "data"]

@@ -41,10 +41,10 @@ class SramModel:
     """The SRAM part on ``<prefix>_*`` of ``dut``; call :meth:`start` once the DUT is out of reset."""
 
     def __init__(self, dut, clk, part: SramPart, *, prefix: str = "sram", period_ns: float = 10.0,
-                 strict: bool = True, sleep: bool = True):
+                 strict: bool = True, sleep: bool = True, log: bool = False):
         self.clk = clk
         self.part = part
-        self.chip = SramChip(part, strict=strict, period_ns=period_ns)
+        self.chip = SramChip(part, strict=strict, period_ns=period_ns, log=log)
         self.period_ns = period_ns
         self.sleep = sleep
         g = lambda f: getattr(dut, f"{prefix}_{f}")  # noqa: E731

@@ -192,6 +192,7 @@ class SramChip:
     part: SramPart = field(default_factory=SramPart)
     strict: bool = True
     period_ns: float = 10.0
+    log: bool = False  # keep every access: write_log (edge, addr, word after the write), read_log (edge, addr)
     violations: list = field(default_factory=list)
     stats: SramStats = field(default_factory=SramStats)
 
@@ -204,6 +205,8 @@ class SramChip:
         self._last_fpga_cycle = -(1 << 30)
         self._t = None
         self._t0 = None
+        self.write_log: list[tuple[int, int, int]] = []
+        self.read_log: list[tuple[int, int]] = []
 
     # ---------------------------------------------------------------------------------------------
     def word(self, addr: int) -> int:
@@ -262,6 +265,8 @@ class SramChip:
             else:
                 st.reads += 1
                 addr = p.addr or 0
+                if self.log:
+                    self.read_log.append((t, addr))
                 # Coherency: writes registered before this read and still waiting for data are forwarded.
                 self._reads.append(_Read(t, addr, self.word(addr), [w for w in self._writes if w.addr == addr]))
         else:
@@ -318,6 +323,8 @@ class SramChip:
                     data |= (byte & 0xFF) << (8 * b)
             due.data = data
             self.mem[due.addr] = self._write_bytes(self.word(due.addr), data, due.bw_n)
+            if self.log:
+                self.write_log.append((due.edge, due.addr, self.mem[due.addr]))
 
         # 4. read data driven during cycle t
         out = None
@@ -336,4 +343,5 @@ class SramChip:
         return not self._reads and not self._writes and not self._drove
 
     def pending(self) -> str:
-        return f"{len(self._reads)} reads, {len(self._writes)} writes in flight"
+        return (f"{len(self._reads)} reads, {len(self._writes)} writes in flight (last edge {self._t}; "
+                f"writes of edges {[w.edge for w in self._writes][:4]}, reads of edges {[r.edge for r in self._reads][:4]})")

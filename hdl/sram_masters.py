@@ -1,0 +1,512 @@
+"""The SRAM arbiter's masters: each port's engine that turns its traffic into word accesses.
+
+Helpers of :func:`eyestereo.hdl.sram_arbiter.sram_arbiter` (not catalogue blocks). Every engine presents
+its next access on a :class:`Head` and learns by ``grant`` that the arbiter issued it at this edge:
+
+* :func:`camera_in` + :func:`writer_issue` -- a camera's queue read port into its double buffer;
+* :func:`rect_in` + :func:`writer_issue` -- the stereo image stream, left and right pixel of each (x, y)
+  packed into one word, into the rectified double buffer;
+* :func:`feature_in` + :func:`writer_issue` -- feature-list words into the feature double buffer;
+* :func:`fetch_slave` -- the pixel fetch port: up to four reads per request;
+* :func:`host_slave` -- the host port: single reads and writes.
+
+Writers buffer their words in a small LUT-RAM FIFO and ask for the bus in bursts (``start``: a burst's
+worth is waiting, or a frame's last word), so that writes come grouped and the bus turns round once per
+burst, not once per word.
+"""
+
+from __future__ import annotations
+
+from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv
+
+from eyestereo.hdl.common.arith import shift_add
+from eyestereo.hdl.common.fifo import sync_fifo
+from eyestereo.tools.sram import ADDR_BITS, DATA_BITS
+
+# FIFO entry of the writers: data (16), sof (16), eof (17), buffer (18), list overflow (19)
+ENTRY_BITS = DATA_BITS + 4
+SOF, EOF, BUF, OVF = DATA_BITS, DATA_BITS + 1, DATA_BITS + 2, DATA_BITS + 3
+
+
+class Head:
+    """One master's next access, as the arbiter sees it.
+
+    ``req``: an access is ready; ``start``: the master may start a turn (a writer: a burst is waiting);
+    ``urgent``: it must be served before the round robin (camera writers, a nearly full writer);
+    ``we, addr, wdata, be``: the access; ``idx``: the fetch index returned with read data;
+    ``grant`` (from the arbiter): the access is issued at this edge.
+    """
+
+    def __init__(self):
+        self.req = Signal(bool(0))
+        self.start = Signal(bool(0))
+        self.urgent = Signal(bool(0))
+        self.we = Signal(bool(0))
+        self.addr = Signal(intbv(0)[ADDR_BITS:])
+        self.wdata = Signal(intbv(0)[DATA_BITS:])
+        self.be = Signal(intbv(3)[2:])
+        self.idx = Signal(intbv(0)[2:])
+        self.grant = Signal(bool(0))
+
+
+# ------------------------------------------------------------------------------------------------------
+@block
+def writer_issue(clk, rst, entry, count, pop, push_eof, head, side, lcount0, lcount1, lovf,
+                 *, base0: int, base1: int, depth: int, burst: int, urgent_level: int, always_urgent: bool):
+    """The SRAM side of a writer: its FIFO's head word to consecutive addresses of its buffer.
+
+    The word flagged ``sof`` goes to the buffer's base address, the others follow it; issuing the word
+    flagged ``eof`` publishes the buffer (``side.p_done``) and records the frame's word count
+    (``lcount0``/``lcount1`` for buffer 0/1) and overflow flag (``lovf`` bit per buffer).
+    """
+    waddr = Signal(intbv(0)[ADDR_BITS:])
+    eofs = Signal(intbv(0, min=0, max=depth + 1))  # eof words in the FIFO
+    nwords = Signal(intbv(0)[len(lcount0):])       # words of the current frame issued so far
+    sof = Signal(bool(0))
+    eof = Signal(bool(0))
+    buf = Signal(bool(0))
+    ovf = Signal(bool(0))
+    has = Signal(bool(0))
+    cmax = (1 << len(lcount0)) - 1
+
+    @always_comb
+    def fields():
+        sof.next = entry[SOF]
+        eof.next = entry[EOF]
+        buf.next = entry[BUF]
+        ovf.next = entry[OVF]
+        head.wdata.next = entry[DATA_BITS:0]
+
+    @always_comb
+    def present():
+        has.next = count != 0
+        head.req.next = count != 0
+        head.we.next = True
+        head.be.next = 3
+        head.idx.next = 0
+        if sof:
+            if buf:
+                head.addr.next = base1
+            else:
+                head.addr.next = base0
+        else:
+            head.addr.next = waddr
+        wants = count >= burst or eofs != 0
+        head.start.next = wants
+        if always_urgent:
+            head.urgent.next = wants
+        else:
+            head.urgent.next = count >= urgent_level
+
+    @always_comb
+    def handshake():
+        pop.next = head.grant
+        side.p_done.next = head.grant and eof
+        side.p_done_buf.next = buf
+
+    @always_seq(clk.posedge, reset=rst)
+    def track():
+        if head.grant:
+            waddr.next = head.addr + 1
+            if sof:
+                nwords.next = 1
+            elif nwords != cmax:
+                nwords.next = nwords + 1
+            if eof:
+                if buf:
+                    if sof:
+                        lcount1.next = 1
+                    elif nwords != cmax:
+                        lcount1.next = nwords + 1
+                    lovf.next[1] = ovf
+                else:
+                    if sof:
+                        lcount0.next = 1
+                    elif nwords != cmax:
+                        lcount0.next = nwords + 1
+                    lovf.next[0] = ovf
+        if push_eof and not (head.grant and eof):
+            eofs.next = eofs + 1
+        elif head.grant and eof and not push_eof:
+            eofs.next = eofs - 1
+
+    return fields, present, handshake, track
+
+
+# ------------------------------------------------------------------------------------------------------
+@block
+def camera_in(clk, rst, q, push, entry_in, push_eof, count, side, run, arm, *, depth: int):
+    """A camera's queue read port into the writer FIFO, one frame per buffer.
+
+    A frame is captured when it starts while ``run`` is high or the camera is armed (``arm`` pulse, used
+    up by the next frame captured) and its double buffer has a buffer free; otherwise its words are
+    taken and discarded. A reset token (``eof`` without ``eol``) abandons the frame in progress (its
+    buffer goes back to FREE). ``ready`` comes from the FIFO count register only.
+    """
+    take = Signal(bool(0))
+    token = Signal(bool(0))
+    first = Signal(bool(0))
+    capture = Signal(bool(0))
+    in_frame = Signal(bool(0))
+    cap = Signal(bool(0))
+    cur = Signal(bool(0))
+    armed = Signal(bool(0))
+    bufsel = Signal(bool(0))
+    zero = Signal(bool(0))  # never driven: a constant 0
+
+    @always_comb
+    def decide():
+        q.ready.next = count != depth
+        t = q.valid and count != depth
+        take.next = t
+        token.next = t and q.eof and not q.eol
+        first.next = t and not in_frame and not (q.eof and not q.eol)
+        side.p_start.next = t and not in_frame and not (q.eof and not q.eol) and (run or armed)
+        capture.next = t and not in_frame and not (q.eof and not q.eol) and (run or armed) and side.p_avail
+        side.p_abort.next = t and q.eof and not q.eol and in_frame and cap
+        side.p_abort_buf.next = cur
+
+    @always_comb
+    def store():
+        if in_frame:
+            bufsel.next = cur
+            push.next = take and not token and cap
+            push_eof.next = take and not token and cap and q.eof
+        else:
+            bufsel.next = side.p_pick
+            push.next = capture
+            push_eof.next = capture and q.eof
+        entry_in.next = concat(zero, bufsel, q.eof, first, q.data)
+
+    @always_seq(clk.posedge, reset=rst)
+    def frames():
+        if arm:
+            armed.next = True
+        if token:
+            in_frame.next = False
+        elif take:
+            if first:
+                cap.next = capture
+                cur.next = side.p_pick
+                if capture and not arm:
+                    armed.next = False
+                in_frame.next = not q.eof
+            elif q.eof:
+                in_frame.next = False
+
+    return decide, store, frames
+
+
+# ------------------------------------------------------------------------------------------------------
+@block
+def rect_in(clk, rst, s, push, entry_in, push_eof, count, side, overflows, *, depth: int):
+    """The stereo image stream (8-bit, ``cam``) into the writer FIFO: one word per (x, y), left pixel in
+    bits 7..0, right pixel in 15..8, pushed with the right pixel's beat. Every frame is captured when a
+    buffer is free (else dropped, counted). The stream cannot wait: a word that finds the FIFO full is
+    lost and counted in ``overflows`` (the arbiter's priorities keep it at 0). A reset token abandons
+    the frame in progress.
+    """
+    left = Signal(intbv(0)[8:])
+    pair = Signal(bool(0))
+    token = Signal(bool(0))
+    first = Signal(bool(0))
+    capture = Signal(bool(0))
+    in_frame = Signal(bool(0))
+    cap = Signal(bool(0))
+    cur = Signal(bool(0))
+    bufsel = Signal(bool(0))
+    keep = Signal(bool(0))
+    zero = Signal(bool(0))  # never driven: a constant 0
+
+    @always_comb
+    def decide():
+        token.next = s.valid and s.eof and not s.eol
+        pair.next = s.valid and s.cam and not (s.eof and not s.eol)
+        first.next = s.valid and s.cam and not (s.eof and not s.eol) and not in_frame
+        side.p_start.next = s.valid and s.cam and not (s.eof and not s.eol) and not in_frame
+        capture.next = s.valid and s.cam and not (s.eof and not s.eol) and not in_frame and side.p_avail
+        side.p_abort.next = s.valid and s.eof and not s.eol and in_frame and cap
+        side.p_abort_buf.next = cur
+
+    @always_comb
+    def store():
+        if in_frame:
+            bufsel.next = cur
+            keep.next = pair and cap
+            push.next = pair and cap and count != depth
+            push_eof.next = pair and cap and count != depth and s.eof
+        else:
+            bufsel.next = side.p_pick
+            keep.next = capture
+            push.next = capture and count != depth
+            push_eof.next = capture and count != depth and s.eof
+        entry_in.next = concat(zero, bufsel, s.eof, first, s.data, left)
+
+    @always_seq(clk.posedge, reset=rst)
+    def frames():
+        if s.valid and not s.cam and not (s.eof and not s.eol):
+            left.next = s.data
+        if keep and count == depth:
+            overflows.next = overflows + 1
+        if token:
+            in_frame.next = False
+        elif pair:
+            if first:
+                cap.next = capture
+                cur.next = side.p_pick
+                in_frame.next = not s.eof
+            elif s.eof:
+                in_frame.next = False
+
+    return decide, store, frames
+
+
+# ------------------------------------------------------------------------------------------------------
+@block
+def feature_in(clk, rst, q, push, entry_in, push_eof, count, side, *, depth: int, capacity: int):
+    """Feature-list words (queue read port) into the writer FIFO, one list per buffer, ``eof`` on a
+    list's last word. A list longer than the buffer's ``capacity`` keeps its first ``capacity - 1``
+    words and its last one, and is flagged as overflowed. Lists are captured whenever a buffer is free.
+    """
+    take = Signal(bool(0))
+    first = Signal(bool(0))
+    capture = Signal(bool(0))
+    in_list = Signal(bool(0))
+    cap = Signal(bool(0))
+    cur = Signal(bool(0))
+    bufsel = Signal(bool(0))
+    n = Signal(intbv(0, min=0, max=capacity + 1))  # words of the list taken (saturating)
+    ovf = Signal(bool(0))
+    room = Signal(bool(0))
+
+    @always_comb
+    def decide():
+        q.ready.next = count != depth
+        t = q.valid and count != depth
+        take.next = t
+        first.next = t and not in_list
+        side.p_start.next = t and not in_list
+        capture.next = t and not in_list and side.p_avail
+        side.p_abort.next = False
+        side.p_abort_buf.next = cur
+
+    @always_comb
+    def store():
+        if in_list:
+            bufsel.next = cur
+            room.next = n < capacity - 1
+            push.next = take and cap and (n < capacity - 1 or q.eof)
+            push_eof.next = take and cap and q.eof
+        else:
+            bufsel.next = side.p_pick
+            room.next = True
+            push.next = capture
+            push_eof.next = capture and q.eof
+        entry_in.next = concat(ovf, bufsel, q.eof, first, q.data)
+
+    @always_seq(clk.posedge, reset=rst)
+    def lists():
+        if take:
+            if first:
+                cap.next = capture
+                cur.next = side.p_pick
+                in_list.next = not q.eof
+                n.next = 1
+                ovf.next = False
+            else:
+                if n != capacity:
+                    n.next = n + 1
+                if not room and not q.eof:
+                    ovf.next = True
+                if q.eof:
+                    in_list.next = False
+
+    return decide, store, lists
+
+
+# ------------------------------------------------------------------------------------------------------
+@block
+def fetch_slave(clk, rst, fp, head, cbuf0, cbuf1, *, width: int, height: int, bases: tuple):
+    """The pixel fetch port's slave side: up to four reads per request, lowest index first.
+
+    Three register stages: A takes the request (``req_ready`` = A empty) and computes y * width by
+    shifts and adds; B adds the buffer's base address and x; C issues the request's reads one per grant.
+    ``bases[c][b]`` is the base address of camera c's buffer b; ``cbuf0``/``cbuf1`` say which buffer of
+    each camera is held for reading.
+    """
+    yw_max = (height - 1) * width
+    yw = Signal(intbv(0, min=0, max=yw_max + 1))
+    a_v = Signal(bool(0))
+    a_yw = Signal(intbv(0, min=0, max=yw_max + 1))
+    a_x = Signal(intbv(0, min=0, max=width))
+    a_cam = Signal(bool(0))
+    a_mask = Signal(intbv(0)[4:])
+    b_v = Signal(bool(0))
+    b_a = Signal(intbv(0)[ADDR_BITS:])
+    b_mask = Signal(intbv(0)[4:])
+    b_first = Signal(intbv(0)[ADDR_BITS:])
+    c_v = Signal(bool(0))
+    c_a = Signal(intbv(0)[ADDR_BITS:])
+    c_mask = Signal(intbv(0)[4:])
+    c_cur = Signal(intbv(0)[ADDR_BITS:])
+    c_next = Signal(intbv(0)[ADDR_BITS:])
+    c_idx = Signal(intbv(0)[2:])
+    c_last = Signal(bool(0))
+    base = Signal(intbv(0)[ADDR_BITS:])
+    (l0b0, l0b1), (l1b0, l1b1) = bases
+    w1 = width + 1
+    move_c = Signal(bool(0))
+    load_c = Signal(bool(0))
+    move_b = Signal(bool(0))
+
+    insts = [shift_add([(fp.req_y, width)], yw)]
+
+    @always_comb
+    def base_select():
+        if a_cam:
+            base.next = l1b1 if cbuf1 else l1b0
+        else:
+            base.next = l0b1 if cbuf0 else l0b0
+
+    @always_comb
+    def offsets():
+        # address of B's lowest wanted index, and of C's second lowest
+        if b_mask[0]:
+            b_first.next = b_a + w1
+        elif b_mask[1]:
+            b_first.next = b_a + width
+        elif b_mask[2]:
+            b_first.next = b_a + 1
+        else:
+            b_first.next = b_a
+        # C: the index after the current one
+        if c_mask[0] and c_mask[1]:
+            c_next.next = c_a + width
+        elif (c_mask[0] or c_mask[1]) and c_mask[2]:
+            c_next.next = c_a + 1
+        else:
+            c_next.next = c_a
+        if c_mask[0]:
+            c_idx.next = 0
+        elif c_mask[1]:
+            c_idx.next = 1
+        elif c_mask[2]:
+            c_idx.next = 2
+        else:
+            c_idx.next = 3
+        # one wanted index left
+        c_last.next = c_mask == 1 or c_mask == 2 or c_mask == 4 or c_mask == 8
+
+    @always_comb
+    def present():
+        head.req.next = c_v
+        head.start.next = c_v
+        head.urgent.next = False
+        head.we.next = False
+        head.addr.next = c_cur
+        head.wdata.next = 0
+        head.be.next = 3
+        head.idx.next = c_idx
+        fp.req_ready.next = not a_v
+        move_c.next = head.grant and c_last                   # C finishes its request
+        load_c.next = b_v and (not c_v or (head.grant and c_last))
+        move_b.next = a_v and (not b_v or not c_v or (head.grant and c_last))
+
+    @always_seq(clk.posedge, reset=rst)
+    def stages():
+        # A
+        if fp.req_valid and not a_v:
+            a_v.next = True
+        elif move_b:
+            a_v.next = False
+        # B
+        if move_b:
+            b_v.next = True
+        elif load_c:
+            b_v.next = False
+        # C
+        if load_c:
+            c_v.next = True
+        elif move_c:
+            c_v.next = False
+
+    @always(clk.posedge)
+    def data():
+        if fp.req_valid and not a_v:
+            a_yw.next = yw
+            a_x.next = fp.req_x
+            a_cam.next = fp.req_cam
+            a_mask.next = fp.req_mask
+        if move_b:
+            b_a.next = base + a_yw + a_x
+            b_mask.next = a_mask
+        if load_c:
+            c_a.next = b_a
+            c_mask.next = b_mask
+            c_cur.next = b_first
+        elif head.grant:
+            if c_mask[0]:
+                c_mask.next[0] = 0
+            elif c_mask[1]:
+                c_mask.next[1] = 0
+            elif c_mask[2]:
+                c_mask.next[2] = 0
+            else:
+                c_mask.next[3] = 0
+            c_cur.next = c_next
+
+    insts += [base_select, offsets, present, stages, data]
+    return insts
+
+
+# ------------------------------------------------------------------------------------------------------
+@block
+def host_slave(clk, rst, hp, head):
+    """The host port: one request register, taken when empty (``req_ready``), issued when granted."""
+    hv = Signal(bool(0))
+    hwe = Signal(bool(0))
+    haddr = Signal(intbv(0)[ADDR_BITS:])
+    hdata = Signal(intbv(0)[DATA_BITS:])
+    hbe = Signal(intbv(0)[2:])
+
+    @always_comb
+    def present():
+        hp.req_ready.next = not hv
+        head.req.next = hv
+        head.start.next = hv
+        head.urgent.next = False
+        head.we.next = hwe
+        head.addr.next = haddr
+        head.wdata.next = hdata
+        head.be.next = hbe
+        head.idx.next = 0
+
+    @always_seq(clk.posedge, reset=rst)
+    def valid():
+        if hp.req_valid and not hv:
+            hv.next = True
+        elif head.grant:
+            hv.next = False
+
+    @always(clk.posedge)
+    def regs():
+        if hp.req_valid and not hv:
+            hwe.next = hp.req_we
+            haddr.next = hp.req_addr
+            hdata.next = hp.req_wdata
+            hbe.next = hp.req_be
+
+    return present, valid, regs
+
+
+@block
+def frame_writer(clk, rst, entry_in, push, push_eof, count, head, side, lcount0, lcount1, lovf, *, base0: int,
+                 base1: int, depth: int, burst: int, urgent_level: int, always_urgent: bool):
+    """A writer's FIFO (LUT-RAM, ``depth`` entries) and its SRAM side (:func:`writer_issue`); the input side
+    (:func:`camera_in`, :func:`rect_in`, :func:`feature_in`) pushes ``entry_in``."""
+    entry = Signal(intbv(0)[ENTRY_BITS:])
+    pop = Signal(bool(0))
+    fifo = sync_fifo(clk, rst, entry_in, push, entry, pop, count, depth=depth)
+    issue = writer_issue(clk, rst, entry, count, pop, push_eof, head, side, lcount0, lcount1, lovf, base0=base0,
+                         base1=base1, depth=depth, burst=burst, urgent_level=urgent_level, always_urgent=always_urgent)
+    return fifo, issue

@@ -1,0 +1,44 @@
+"""The SRAM subsystem: arbiter and controller together, the SRAM's pins on one side, the six masters on the other."""
+
+from myhdl import block
+
+from eyestereo.hdl.common.checks import check_choice, check_int
+from eyestereo.hdl.sram_arbiter import TAG_BITS, sram_arbiter
+from eyestereo.hdl.sram_bus import SramCmd, SramPins, SramRsp
+from eyestereo.hdl.sram_controller import sram_controller
+from eyestereo.tools.sram import KINDS
+
+
+@block
+def sram_subsystem(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, sram, *, kind: str = "nobl",
+                   read_latency: int = 2, width: int = 352, height: int = 288, feature_words: int = 8192,
+                   depth: int = 16, burst: int = 8, fetch_burst: int = 8, host_burst: int = 2,
+                   counter_bits: int = 32):
+    """:func:`~eyestereo.hdl.sram_arbiter.sram_arbiter` on :func:`~eyestereo.hdl.sram_controller.sram_controller`.
+
+    What the complete system instantiates: the masters' ports as the arbiter documents them, the frame
+    handshake, the status port, and the SRAM's pins (:class:`~eyestereo.hdl.sram_bus.SramPins`).
+
+    Ports:
+        clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat: as :func:`sram_arbiter`.
+        sram: :class:`~eyestereo.hdl.sram_bus.SramPins`.
+
+    Parameters:
+        kind, read_latency: the part (:func:`sram_controller`).
+        width, height, feature_words, depth, burst, fetch_burst, host_burst, counter_bits: as
+            :func:`sram_arbiter`.
+
+    Latency: a fetch request's first pixel read_latency + 6 clocks after it is taken on an idle bus;
+    a host read's data read_latency + 5 clocks after it is taken.
+
+    Resources: see docs/sram.md.
+    """
+    kind = check_choice("kind", kind, KINDS)
+    read_latency = check_int("read_latency", read_latency, 1, 3)
+    cmd = SramCmd(tag_bits=TAG_BITS)
+    rsp = SramRsp(tag_bits=TAG_BITS)
+    arb = sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, rsp, width=width,
+                       height=height, feature_words=feature_words, depth=depth, burst=burst,
+                       fetch_burst=fetch_burst, host_burst=host_burst, counter_bits=counter_bits)
+    ctrl = sram_controller(clk, rst, cmd, rsp, sram, kind=kind, read_latency=read_latency)
+    return arb, ctrl
