@@ -160,7 +160,7 @@ def _masters(p):
                 stat=StatPort())
 
 
-_ARB = dict(width=352, height=288, feature_words=8192, depth=16, burst=8, fetch_burst=8, host_burst=2,
+_ARB = dict(width=352, height=288, feature_words=8192, depth=16, burst=8, fetch_burst=8, host_burst=1,
             counter_bits=32)
 
 BLOCKS["sram_arbiter"] = BlockSpec(

@@ -9,7 +9,7 @@ from eyestereo.hdl.queue_port import QueuePort
 from eyestereo.hdl.sram_bus import HostPort, SramCmd, SramRsp, StatPort
 from eyestereo.hdl.sram_masters import (ENTRY_BITS, Head, camera_in, feature_in, fetch_slave, frame_writer, host_slave,
                                         rect_in)
-from eyestereo.tools.models.sram_arbiter import MASTERS, STAT, AddressMap
+from eyestereo.tools.models.sram_arbiter import MASTERS, AddressMap
 
 NM = len(MASTERS)
 CAM0, CAM1, FETCH, RECT, FEAT, HOST = range(NM)
@@ -37,7 +37,7 @@ def counter(clk, rst, inc, q):
 @block
 def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, rsp, *, width: int = 352,
                  height: int = 288, feature_words: int = 8192, depth: int = 16, burst: int = 8,
-                 fetch_burst: int = 8, host_burst: int = 2, counter_bits: int = 32):
+                 fetch_burst: int = 8, host_burst: int = 1, counter_bits: int = 32):
     """Six masters, each a port of its own kind, share one SRAM word port, with double-buffered frames.
 
     Masters (index, port): 0, 1 ``cam0``/``cam1`` -- camera writers (queue read ports of 16-bit camera
@@ -156,14 +156,14 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
         ctl.feat_held.next = s_f.c_held
         ctl.feat_buf.next = s_f.c_buf
 
-    full = [Signal(bool(0)) for _ in range(4)]
+    full0, full1, full2, full3 = (Signal(bool(0)) for _ in range(4))
 
     @always_comb
     def avail_bits():
-        ctl.avail.next = concat(full[3], full[2], full[1], full[0])
+        ctl.avail.next = concat(full3, full2, full1, full0)
 
-    for i, sd in enumerate(sides):
-        insts.append(any_full(sd.state, full[i]))
+    for sd, f in zip(sides, (full0, full1, full2, full3)):
+        insts.append(any_full(sd.state, f))
     insts += [control, avail_bits]
 
     # ---- writers ------------------------------------------------------------------------------
@@ -214,171 +214,200 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     insts += [responses, response_valid]
 
     # ---- arbitration ----------------------------------------------------------------------------
+    # Two registered decisions keep the clock-to-clock logic short: the *owner* of the bus (registered)
+    # issues one access per clock while it has one, for up to its burst length; the *next* owner is
+    # chosen one clock ahead (registered) from the masters' registered start/urgent flags, round robin
+    # from the current owner. The command to the controller is registered too (``slot``).
     h0, h1, h2, h3, h4, h5 = heads
     reqv = ConcatSignal(h5.req, h4.req, h3.req, h2.req, h1.req, h0.req)
     startv = ConcatSignal(h5.start, h4.start, h3.start, h2.start, h1.start, h0.start)
     urgv = ConcatSignal(h5.urgent, h4.urgent, h3.urgent, h2.urgent, h1.urgent, h0.urgent)
     bursts = (burst, burst, fetch_burst, burst, burst, host_burst)
     maxb = max(bursts)
-    own = Signal(intbv(0, min=0, max=NM))
+    own = Signal(intbv(NM - 1, min=0, max=NM))
     own_v = Signal(bool(0))
     own_urg = Signal(bool(0))
     beats = Signal(intbv(0, min=0, max=maxb + 1))
-    rr = Signal(intbv(NM - 1, min=0, max=NM))
-    sel = Signal(intbv(0, min=0, max=NM))
-    go = Signal(bool(0))
-    keep = Signal(bool(0))
-    sel_urg = Signal(bool(0))
-    granted = Signal(bool(0))
-    gv = Signal(intbv(0)[NM:])
-    urg = Signal(intbv(0)[NM:])
+    nxt = Signal(intbv(0, min=0, max=NM))
+    nxt_v = Signal(bool(0))
+    nxt_urg = Signal(bool(0))
+    preempt = Signal(bool(0))
+    nxt_c = Signal(intbv(0, min=0, max=NM))
+    nxt_vc = Signal(bool(0))
+    nxt_urgc = Signal(bool(0))
+    preempt_c = Signal(bool(0))
+    issue = Signal(bool(0))
+    turn_over = Signal(bool(0))
     blen = Signal(intbv(0, min=0, max=maxb + 1))
+    urg = Signal(intbv(0)[NM:])
+    pool = Signal(intbv(0)[NM:])
+    cand = Signal(intbv(0)[NM:])
+    after = Signal(intbv(0)[NM:])
+    AFTER = tuple(((1 << NM) - 1) & ~((1 << (k + 1)) - 1) for k in range(NM))  # masters above k
+    gv = Signal(intbv(0)[NM:])
     wantv = Signal(intbv(0)[NM:])
+    slot_v = Signal(bool(0))
+    slot_we = Signal(bool(0))
+    slot_addr = Signal(intbv(0)[len(cmd.addr):])
+    slot_wdata = Signal(intbv(0)[len(cmd.wdata):])
+    slot_be = Signal(intbv(0)[2:])
+    slot_tag = Signal(intbv(0)[TAG_BITS:])
 
     @always_comb
     def urgency():
         urg.next = urgv & startv
 
     @always_comb
-    def choose():
-        k = own_v and reqv[own] and beats != 0 and (own_urg or urg == 0)
-        keep.next = k
-        s = int(own)
-        g = False
-        u = bool(own_urg)
-        if not k:
-            u = urg != 0
-            for i in range(NM):
-                m = int(rr) + 1 + i
-                if m >= NM:
-                    m = m - NM
-                if not g:
-                    if urg != 0:
-                        if urg[m]:
-                            s = m
-                            g = True
-                    elif startv[m]:
-                        s = m
-                        g = True
+    def pools():
+        if urg != 0:
+            pool.next = urg
         else:
-            g = True
-        sel.next = s
-        go.next = g
-        sel_urg.next = u
+            pool.next = startv
+        after.next = AFTER[own]
 
     @always_comb
-    def mux():
-        cmd.valid.next = go
-        cmd.we.next = False
-        cmd.addr.next = 0
-        cmd.wdata.next = 0
-        cmd.be.next = 3
-        cmd.tag.next = 0
-        if sel == CAM0:
-            cmd.we.next = h0.we
-            cmd.addr.next = h0.addr
-            cmd.wdata.next = h0.wdata
-            cmd.be.next = h0.be
-        elif sel == CAM1:
-            cmd.we.next = h1.we
-            cmd.addr.next = h1.addr
-            cmd.wdata.next = h1.wdata
-            cmd.be.next = h1.be
-        elif sel == FETCH:
-            cmd.we.next = h2.we
-            cmd.addr.next = h2.addr
-            cmd.tag.next = h2.idx
-        elif sel == RECT:
-            cmd.we.next = h3.we
-            cmd.addr.next = h3.addr
-            cmd.wdata.next = h3.wdata
-            cmd.be.next = h3.be
-        elif sel == FEAT:
-            cmd.we.next = h4.we
-            cmd.addr.next = h4.addr
-            cmd.wdata.next = h4.wdata
-            cmd.be.next = h4.be
+    def masked():
+        if (pool & after) != 0:
+            cand.next = pool & after
         else:
-            cmd.we.next = h5.we
-            cmd.addr.next = h5.addr
-            cmd.wdata.next = h5.wdata
-            cmd.be.next = h5.be
-            cmd.tag.next = 4
+            cand.next = pool
 
     @always_comb
-    def grants():
-        gr = go and cmd.ready
-        granted.next = gr
-        h0.grant.next = gr and sel == CAM0
-        h1.grant.next = gr and sel == CAM1
-        h2.grant.next = gr and sel == FETCH
-        h3.grant.next = gr and sel == RECT
-        h4.grant.next = gr and sel == FEAT
-        h5.grant.next = gr and sel == HOST
+    def next_choice():
+        # round robin: the lowest master above the current owner in the pool, else the lowest in it
+        # (the owner itself comes last); the pool is the urgent masters if any, else all that ask
+        if cand[0]:
+            nxt_c.next = 0
+        elif cand[1]:
+            nxt_c.next = 1
+        elif cand[2]:
+            nxt_c.next = 2
+        elif cand[3]:
+            nxt_c.next = 3
+        elif cand[4]:
+            nxt_c.next = 4
+        else:
+            nxt_c.next = 5
+        nxt_vc.next = cand != 0
+        nxt_urgc.next = urg != 0
+        preempt_c.next = own_v and not own_urg and urg != 0
+
+    @always_comb
+    def issue_logic():
+        r = reqv[own]
+        iss = own_v and r and (not slot_v or cmd.ready) and not preempt
+        issue.next = iss
+        turn_over.next = not own_v or not r or preempt or (iss and beats == 1)
+        h0.grant.next = iss and own == CAM0
+        h1.grant.next = iss and own == CAM1
+        h2.grant.next = iss and own == FETCH
+        h3.grant.next = iss and own == RECT
+        h4.grant.next = iss and own == FEAT
+        h5.grant.next = iss and own == HOST
+
+    @always_comb
+    def burst_length():
+        blen.next = bursts[nxt]
+
+    @always_seq(clk.posedge, reset=rst)
+    def turn():
+        nxt.next = nxt_c
+        nxt_v.next = nxt_vc
+        nxt_urg.next = nxt_urgc
+        preempt.next = preempt_c and not turn_over
+        if turn_over:
+            own.next = nxt
+            own_v.next = nxt_v
+            own_urg.next = nxt_urg
+            beats.next = blen
+        elif issue:
+            beats.next = beats - 1
+        if issue:
+            slot_v.next = True
+        elif cmd.ready:
+            slot_v.next = False
+
+    @always(clk.posedge)
+    def slot():
+        if issue:
+            slot_tag.next = 0
+            if own == CAM0:
+                slot_we.next = h0.we
+                slot_addr.next = h0.addr
+                slot_wdata.next = h0.wdata
+                slot_be.next = h0.be
+            elif own == CAM1:
+                slot_we.next = h1.we
+                slot_addr.next = h1.addr
+                slot_wdata.next = h1.wdata
+                slot_be.next = h1.be
+            elif own == FETCH:
+                slot_we.next = h2.we
+                slot_addr.next = h2.addr
+                slot_tag.next = h2.idx
+            elif own == RECT:
+                slot_we.next = h3.we
+                slot_addr.next = h3.addr
+                slot_wdata.next = h3.wdata
+                slot_be.next = h3.be
+            elif own == FEAT:
+                slot_we.next = h4.we
+                slot_addr.next = h4.addr
+                slot_wdata.next = h4.wdata
+                slot_be.next = h4.be
+            else:
+                slot_we.next = h5.we
+                slot_addr.next = h5.addr
+                slot_wdata.next = h5.wdata
+                slot_be.next = h5.be
+                slot_tag.next = 4
+
+    @always_comb
+    def command():
+        cmd.valid.next = slot_v
+        cmd.we.next = slot_we
+        cmd.addr.next = slot_addr
+        cmd.wdata.next = slot_wdata
+        cmd.be.next = slot_be
+        cmd.tag.next = slot_tag
 
     @always_comb
     def bookkeeping():
         gv.next = concat(h5.grant, h4.grant, h3.grant, h2.grant, h1.grant, h0.grant)
         w = intbv(0)[NM:]
         for i in range(NM):
-            w[i] = startv[i] or (own_v and own == i and reqv[i] and beats != 0)
+            w[i] = startv[i] or (own_v and own == i and reqv[i])
         wantv.next = w
 
-    @always_comb
-    def burst_length():
-        blen.next = bursts[sel]
-
-    @always_seq(clk.posedge, reset=rst)
-    def turn():
-        if go:
-            own.next = sel
-            own_v.next = True
-            if keep:
-                if granted:
-                    beats.next = beats - 1
-            else:
-                own_urg.next = sel_urg
-                rr.next = sel
-                if granted:
-                    beats.next = blen - 1
-                else:
-                    beats.next = blen
-
-    insts += [urgency, choose, mux, grants, bookkeeping, burst_length, turn]
+    insts += [urgency, pools, masked, next_choice, issue_logic, burst_length, turn, slot, command, bookkeeping]
 
     # ---- counters and status ----------------------------------------------------------------------
+    # (individual signals, no lists: a list of signals becomes a memory array in the Verilog, which
+    # synthesis turns into wide multiplexers)
     words = [Signal(intbv(0)[counter_bits:]) for _ in range(NM)]
     waits = [Signal(intbv(0)[counter_bits:]) for _ in range(NM)]
-    waiting = [Signal(bool(0)) for _ in range(NM)]
-    moved = [Signal(bool(0)) for _ in range(NM)]
     clocks = Signal(intbv(0)[counter_bits:])
     one = Signal(bool(1))
+    for i in range(NM):
+        moved, waiting = Signal(bool(0)), Signal(bool(0))
+        insts.append(activity(gv, wantv, moved, waiting, index=i))
+        insts.append(counter(clk, rst, moved, words[i]))
+        insts.append(counter(clk, rst, waiting, waits[i]))
+    insts.append(counter(clk, rst, one, clocks))
+    insts.append(stat_mux(clk, stat, words, waits, clocks, sides, rect_lost, lcounts, lovf))
+    return insts
+
+
+@block
+def activity(gv, wantv, moved, waiting, *, index: int):
+    """Master ``index`` moved a word this clock / waited (asked or held a turn, not granted)."""
 
     @always_comb
-    def wait_flags():
-        for i in range(NM):
-            moved[i].next = gv[i]
-            waiting[i].next = wantv[i] and not gv[i]
+    def comb():
+        moved.next = gv[index]
+        waiting.next = wantv[index] and not gv[index]
 
-    insts.append(wait_flags)
-    for i in range(NM):
-        insts.append(counter(clk, rst, moved[i], words[i]))
-        insts.append(counter(clk, rst, waiting[i], waits[i]))
-    insts.append(counter(clk, rst, one, clocks))
-
-    nstat = max(STAT) + 1
-    vals = [Signal(intbv(0)[32:]) for _ in range(nstat)]
-    insts.append(stat_words(words, waits, clocks, sides, rect_lost, lcounts, lovf, vals))
-
-    @always(clk.posedge)
-    def stat_read():
-        if stat.addr < nstat:
-            stat.data.next = vals[stat.addr]
-        else:
-            stat.data.next = 0
-
-    insts.append(stat_read)
-    return insts
+    return comb
 
 
 @block
@@ -393,43 +422,81 @@ def any_full(state, full):
 
 
 @block
-def stat_words(words, waits, clocks, sides, rect_lost, lcounts, lovf, vals):
-    """The status port's words (register map: ``STAT`` in eyestereo.tools.models.sram_arbiter)."""
+def stat_mux(clk, stat, words, waits, clocks, sides, rect_lost, lcounts, lovf):
+    """The status port: the word at ``stat.addr`` (register map ``STAT`` in
+    eyestereo.tools.models.sram_arbiter) registered onto ``stat.data``."""
     s0, s1, s2, s3 = sides
     l0, l1 = lcounts
     pad = Signal(intbv(0)[31 - len(l0):])  # never driven: constant 0
     ovf0, ovf1 = Signal(bool(0)), Signal(bool(0))
-
-    @always_comb
-    def flags():
-        ovf0.next = lovf[0]
-        ovf1.next = lovf[1]
     w0, w1, w2, w3, w4, w5 = words
     t0, t1, t2, t3, t4, t5 = waits
+    f0, f1, f2, f3, f4, f5, f6, f7, f8 = (Signal(intbv(0)[32:]) for _ in range(9))
 
     @always_comb
-    def comb():
-        vals[0].next = w0
-        vals[1].next = w1
-        vals[2].next = w2
-        vals[3].next = w3
-        vals[4].next = w4
-        vals[5].next = w5
-        vals[6].next = t0
-        vals[7].next = t1
-        vals[8].next = t2
-        vals[9].next = t3
-        vals[10].next = t4
-        vals[11].next = t5
-        vals[12].next = clocks
-        vals[13].next = concat(s0.dropped, s0.published)
-        vals[14].next = concat(s1.dropped, s1.published)
-        vals[15].next = concat(s2.dropped, s2.published)
-        vals[16].next = concat(s3.dropped, s3.published)
-        vals[17].next = concat(s1.overwritten, s0.overwritten)
-        vals[18].next = concat(s3.overwritten, s2.overwritten)
-        vals[19].next = concat(rect_lost, s3.state, s2.state, s1.state, s0.state)
-        vals[20].next = concat(ovf0, pad, l0)
-        vals[21].next = concat(ovf1, pad, l1)
+    def fields():
+        ovf0.next = lovf[0]
+        ovf1.next = lovf[1]
+        f0.next = concat(s0.dropped, s0.published)
+        f1.next = concat(s1.dropped, s1.published)
+        f2.next = concat(s2.dropped, s2.published)
+        f3.next = concat(s3.dropped, s3.published)
+        f4.next = concat(s1.overwritten, s0.overwritten)
+        f5.next = concat(s3.overwritten, s2.overwritten)
+        f6.next = concat(rect_lost, s3.state, s2.state, s1.state, s0.state)
 
-    return flags, comb
+    @always_comb
+    def lists():
+        f7.next = concat(ovf0, pad, l0)
+        f8.next = concat(ovf1, pad, l1)
+
+    @always(clk.posedge)
+    def read():
+        if stat.addr == 0:
+            stat.data.next = w0
+        elif stat.addr == 1:
+            stat.data.next = w1
+        elif stat.addr == 2:
+            stat.data.next = w2
+        elif stat.addr == 3:
+            stat.data.next = w3
+        elif stat.addr == 4:
+            stat.data.next = w4
+        elif stat.addr == 5:
+            stat.data.next = w5
+        elif stat.addr == 6:
+            stat.data.next = t0
+        elif stat.addr == 7:
+            stat.data.next = t1
+        elif stat.addr == 8:
+            stat.data.next = t2
+        elif stat.addr == 9:
+            stat.data.next = t3
+        elif stat.addr == 10:
+            stat.data.next = t4
+        elif stat.addr == 11:
+            stat.data.next = t5
+        elif stat.addr == 12:
+            stat.data.next = clocks
+        elif stat.addr == 13:
+            stat.data.next = f0
+        elif stat.addr == 14:
+            stat.data.next = f1
+        elif stat.addr == 15:
+            stat.data.next = f2
+        elif stat.addr == 16:
+            stat.data.next = f3
+        elif stat.addr == 17:
+            stat.data.next = f4
+        elif stat.addr == 18:
+            stat.data.next = f5
+        elif stat.addr == 19:
+            stat.data.next = f6
+        elif stat.addr == 20:
+            stat.data.next = f7
+        elif stat.addr == 21:
+            stat.data.next = f8
+        else:
+            stat.data.next = 0
+
+    return fields, lists, read

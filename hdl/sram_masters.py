@@ -91,12 +91,6 @@ def writer_issue(clk, rst, entry, count, pop, push_eof, head, side, lcount0, lco
                 head.addr.next = base0
         else:
             head.addr.next = waddr
-        wants = count >= burst or eofs != 0
-        head.start.next = wants
-        if always_urgent:
-            head.urgent.next = wants
-        else:
-            head.urgent.next = count >= urgent_level
 
     @always_comb
     def handshake():
@@ -106,6 +100,13 @@ def writer_issue(clk, rst, entry, count, pop, push_eof, head, side, lcount0, lco
 
     @always_seq(clk.posedge, reset=rst)
     def track():
+        # start/urgent registered (a clock late: only the arbiter's next-turn choice reads them)
+        wants = count >= burst or eofs != 0
+        head.start.next = wants
+        if always_urgent:
+            head.urgent.next = wants
+        else:
+            head.urgent.next = count >= urgent_level
         if head.grant:
             waddr.next = head.addr + 1
             if sof:
@@ -294,28 +295,30 @@ def feature_in(clk, rst, q, push, entry_in, push_eof, count, side, *, depth: int
     def store():
         if in_list:
             bufsel.next = cur
-            room.next = n < capacity - 1
-            push.next = take and cap and (n < capacity - 1 or q.eof)
+            push.next = take and cap and (room or q.eof)
             push_eof.next = take and cap and q.eof
         else:
             bufsel.next = side.p_pick
-            room.next = True
             push.next = capture
             push_eof.next = capture and q.eof
         entry_in.next = concat(ovf, bufsel, q.eof, first, q.data)
 
     @always_seq(clk.posedge, reset=rst)
     def lists():
+        # room: the word taken next (not the list's last) still has a slot: n < capacity - 1, kept in a
+        # register so that no comparator sits in the push path
         if take:
             if first:
                 cap.next = capture
                 cur.next = side.p_pick
                 in_list.next = not q.eof
                 n.next = 1
+                room.next = capacity > 2
                 ovf.next = False
             else:
                 if n != capacity:
                     n.next = n + 1
+                room.next = n < capacity - 2
                 if not room and not q.eof:
                     ovf.next = True
                 if q.eof:
@@ -329,72 +332,58 @@ def feature_in(clk, rst, q, push, entry_in, push_eof, count, side, *, depth: int
 def fetch_slave(clk, rst, fp, head, cbuf0, cbuf1, *, width: int, height: int, bases: tuple):
     """The pixel fetch port's slave side: up to four reads per request, lowest index first.
 
-    Three register stages: A takes the request (``req_ready`` = A empty) and computes y * width by
-    shifts and adds; B adds the buffer's base address and x; C issues the request's reads one per grant.
+    Four register stages, each with one adder at most between registers: A takes the request
+    (``req_ready`` = A empty) with y * width (shifts and adds); B adds x; P adds the buffer's base and
+    the four neighbours' offsets (four addresses); C issues the wanted ones, one per grant.
     ``bases[c][b]`` is the base address of camera c's buffer b; ``cbuf0``/``cbuf1`` say which buffer of
     each camera is held for reading.
     """
     yw_max = (height - 1) * width
+    yx_max = yw_max + width - 1
     yw = Signal(intbv(0, min=0, max=yw_max + 1))
-    a_v = Signal(bool(0))
+    a_v, b_v, p_v, c_v = (Signal(bool(0)) for _ in range(4))
     a_yw = Signal(intbv(0, min=0, max=yw_max + 1))
     a_x = Signal(intbv(0, min=0, max=width))
-    a_cam = Signal(bool(0))
-    a_mask = Signal(intbv(0)[4:])
-    b_v = Signal(bool(0))
-    b_a = Signal(intbv(0)[ADDR_BITS:])
-    b_mask = Signal(intbv(0)[4:])
-    b_first = Signal(intbv(0)[ADDR_BITS:])
-    c_v = Signal(bool(0))
-    c_a = Signal(intbv(0)[ADDR_BITS:])
-    c_mask = Signal(intbv(0)[4:])
-    c_cur = Signal(intbv(0)[ADDR_BITS:])
-    c_next = Signal(intbv(0)[ADDR_BITS:])
+    a_cam, b_cam = Signal(bool(0)), Signal(bool(0))
+    a_mask, b_mask, p_mask, c_mask = (Signal(intbv(0)[4:]) for _ in range(4))
+    b_yx = Signal(intbv(0, min=0, max=yx_max + 1))
+    base = Signal(intbv(0)[ADDR_BITS:])
+    p0, p1, p2, p3, c0, c1, c2, c3 = (Signal(intbv(0)[ADDR_BITS:]) for _ in range(8))
     c_idx = Signal(intbv(0)[2:])
     c_last = Signal(bool(0))
-    base = Signal(intbv(0)[ADDR_BITS:])
+    move_a, move_b, move_p, move_c = (Signal(bool(0)) for _ in range(4))
     (l0b0, l0b1), (l1b0, l1b1) = bases
     w1 = width + 1
-    move_c = Signal(bool(0))
-    load_c = Signal(bool(0))
-    move_b = Signal(bool(0))
 
     insts = [shift_add([(fp.req_y, width)], yw)]
 
     @always_comb
     def base_select():
-        if a_cam:
-            base.next = l1b1 if cbuf1 else l1b0
+        if b_cam:
+            if cbuf1:
+                base.next = l1b1
+            else:
+                base.next = l1b0
         else:
-            base.next = l0b1 if cbuf0 else l0b0
+            if cbuf0:
+                base.next = l0b1
+            else:
+                base.next = l0b0
 
     @always_comb
-    def offsets():
-        # address of B's lowest wanted index, and of C's second lowest
-        if b_mask[0]:
-            b_first.next = b_a + w1
-        elif b_mask[1]:
-            b_first.next = b_a + width
-        elif b_mask[2]:
-            b_first.next = b_a + 1
-        else:
-            b_first.next = b_a
-        # C: the index after the current one
-        if c_mask[0] and c_mask[1]:
-            c_next.next = c_a + width
-        elif (c_mask[0] or c_mask[1]) and c_mask[2]:
-            c_next.next = c_a + 1
-        else:
-            c_next.next = c_a
+    def current():
         if c_mask[0]:
             c_idx.next = 0
+            head.addr.next = c0
         elif c_mask[1]:
             c_idx.next = 1
+            head.addr.next = c1
         elif c_mask[2]:
             c_idx.next = 2
+            head.addr.next = c2
         else:
             c_idx.next = 3
-        # one wanted index left
+            head.addr.next = c3
         c_last.next = c_mask == 1 or c_mask == 2 or c_mask == 4 or c_mask == 8
 
     @always_comb
@@ -403,29 +392,32 @@ def fetch_slave(clk, rst, fp, head, cbuf0, cbuf1, *, width: int, height: int, ba
         head.start.next = c_v
         head.urgent.next = False
         head.we.next = False
-        head.addr.next = c_cur
         head.wdata.next = 0
         head.be.next = 3
         head.idx.next = c_idx
         fp.req_ready.next = not a_v
-        move_c.next = head.grant and c_last                   # C finishes its request
-        load_c.next = b_v and (not c_v or (head.grant and c_last))
-        move_b.next = a_v and (not b_v or not c_v or (head.grant and c_last))
+        # a stage moves on when the next one is empty or moves on itself
+        mc = head.grant and c_last
+        move_c.next = mc
+        move_p.next = p_v and (not c_v or mc)
+        move_b.next = b_v and (not p_v or not c_v or mc)
+        move_a.next = a_v and (not b_v or not p_v or not c_v or mc)
 
     @always_seq(clk.posedge, reset=rst)
     def stages():
-        # A
         if fp.req_valid and not a_v:
             a_v.next = True
-        elif move_b:
+        elif move_a:
             a_v.next = False
-        # B
-        if move_b:
+        if move_a:
             b_v.next = True
-        elif load_c:
+        elif move_b:
             b_v.next = False
-        # C
-        if load_c:
+        if move_b:
+            p_v.next = True
+        elif move_p:
+            p_v.next = False
+        if move_p:
             c_v.next = True
         elif move_c:
             c_v.next = False
@@ -437,13 +429,22 @@ def fetch_slave(clk, rst, fp, head, cbuf0, cbuf1, *, width: int, height: int, ba
             a_x.next = fp.req_x
             a_cam.next = fp.req_cam
             a_mask.next = fp.req_mask
-        if move_b:
-            b_a.next = base + a_yw + a_x
+        if move_a:
+            b_yx.next = a_yw + a_x
+            b_cam.next = a_cam
             b_mask.next = a_mask
-        if load_c:
-            c_a.next = b_a
-            c_mask.next = b_mask
-            c_cur.next = b_first
+        if move_b:
+            p0.next = base + b_yx + w1
+            p1.next = base + b_yx + width
+            p2.next = base + b_yx + 1
+            p3.next = base + b_yx
+            p_mask.next = b_mask
+        if move_p:
+            c0.next = p0
+            c1.next = p1
+            c2.next = p2
+            c3.next = p3
+            c_mask.next = p_mask
         elif head.grant:
             if c_mask[0]:
                 c_mask.next[0] = 0
@@ -453,9 +454,8 @@ def fetch_slave(clk, rst, fp, head, cbuf0, cbuf1, *, width: int, height: int, ba
                 c_mask.next[2] = 0
             else:
                 c_mask.next[3] = 0
-            c_cur.next = c_next
 
-    insts += [base_select, offsets, present, stages, data]
+    insts += [base_select, current, present, stages, data]
     return insts
 
 

@@ -12,7 +12,7 @@ from eyestereo.tools.sram import KINDS
 @block
 def sram_subsystem(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, sram, *, kind: str = "nobl",
                    read_latency: int = 2, width: int = 352, height: int = 288, feature_words: int = 8192,
-                   depth: int = 16, burst: int = 8, fetch_burst: int = 8, host_burst: int = 2,
+                   depth: int = 16, burst: int = 8, fetch_burst: int = 8, host_burst: int = 1,
                    counter_bits: int = 32):
     """:func:`~eyestereo.hdl.sram_arbiter.sram_arbiter` on :func:`~eyestereo.hdl.sram_controller.sram_controller`.
 

@@ -83,7 +83,7 @@ def test_subsystem_random_traffic(request, kind, seed):
                dict(seed=seed, clocks=6000, rect_duty=0.15, feat_duty=0.05, host_duty=0.05))
     assert rep["takes"]["cam"] >= 2 and rep["frames"]["cam0"] >= 3 and rep["frames"]["cam1"] >= 3
     assert rep["takes"]["rect"] >= 1 and rep["takes"]["feat"] >= 1
-    assert rep["fetch_reads"] > 2000 and rep["host_area_reads"] > 20 and rep["host_buffer_reads"] > 100
+    assert rep["fetch_reads"] > 1500 and rep["host_area_reads"] > 20 and rep["host_buffer_reads"] > 100
     assert max(rep["cam_max_fill"]) <= 4
 
 
@@ -110,7 +110,7 @@ def test_subsystem_reset_token_and_full_speed_fetch(request):
     rep = _sub(request, dict(kind="pipelined", read_latency=2),
                dict(seed=5, clocks=6000, token_after=40, fetch_mode="continuous", rect_duty=0.25))
     assert rep["stat"]["rectified frames: dropped << 16 | published"] & 0xFFFF >= 1
-    assert rep["fetch_reads"] > 2000
+    assert rep["fetch_reads"] > 1500
 
 
 def test_subsystem_icarus(request):
