@@ -96,11 +96,13 @@ class BufferSide:
     """Signals between a writer and its :func:`double_buffer` (internal to the arbiter)."""
 
     def __init__(self):
-        # producer
-        self.p_start = Signal(bool(0))      # pulse: a frame starts; it takes buffer p_pick if p_avail, else
-        #                                     it is dropped (counted)
-        self.p_avail = Signal(bool(0))      # a buffer can be taken now
-        self.p_pick = Signal(bool(0))       # which
+        # producer: a registered request/answer, so that no combinational path crosses
+        self.p_start = Signal(bool(0))      # level: a frame wants a buffer (held until answered)
+        self.p_grant = Signal(bool(0))      # pulse: it got buffer p_gbuf
+        self.p_gbuf = Signal(bool(0))
+        self.p_deny = Signal(bool(0))       # pulse: no buffer: the frame is dropped (counted)
+        self.p_avail = Signal(bool(0))      # (internal) a buffer can be taken now
+        self.p_pick = Signal(bool(0))       # (internal) which
         self.p_done = Signal(bool(0))       # pulse: the frame in buffer p_done_buf is complete
         self.p_done_buf = Signal(bool(0))
         self.p_abort = Signal(bool(0))      # pulse: the frame in buffer p_abort_buf is abandoned
@@ -171,7 +173,11 @@ def double_buffer(clk, rst, side: BufferSide):
     @always_seq(clk.posedge, reset=rst)
     def update():
         taking = side.c_take and side.c_avail
-        starting = side.p_start and side.p_avail
+        asking = side.p_start and not side.p_grant and not side.p_deny  # not the clock it was answered
+        starting = asking and side.p_avail
+        side.p_grant.next = starting
+        side.p_deny.next = asking and not side.p_avail
+        side.p_gbuf.next = side.p_pick
         # producer
         if starting:
             if side.p_pick:
@@ -182,7 +188,7 @@ def double_buffer(clk, rst, side: BufferSide):
                 if s0 == FULL:
                     side.overwritten.next = side.overwritten + 1
                 s0.next = WRITING
-        if side.p_start and not side.p_avail:
+        if asking and not side.p_avail:
             side.dropped.next = side.dropped + 1
         if side.p_done:
             side.published.next = side.published + 1

@@ -184,15 +184,15 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
         e_in, push, push_eof, count = fifo_signals()
         insts.append(frame_writer(clk, rst, e_in, push, push_eof, count, heads[c], sides[c], *dummy_counts(),
                                   base0=amap.camera(c, 0), base1=amap.camera(c, 1), always_urgent=True, **wkw))
-        insts.append(camera_in(clk, rst, q, push, e_in, push_eof, count, sides[c], run, arm, depth=depth))
+        insts.append(camera_in(clk, rst, q, push, e_in, push_eof, count, run, arm, depth=depth))
     e_in, push, push_eof, count = fifo_signals()
     insts.append(frame_writer(clk, rst, e_in, push, push_eof, count, heads[RECT], s_r, *dummy_counts(),
                               base0=amap.rectified(0), base1=amap.rectified(1), always_urgent=False, **wkw))
-    insts.append(rect_in(clk, rst, rect, push, e_in, push_eof, count, s_r, rect_lost, depth=depth))
+    insts.append(rect_in(clk, rst, rect, push, e_in, push_eof, count, rect_lost, depth=depth))
     e_in, push, push_eof, count = fifo_signals()
     insts.append(frame_writer(clk, rst, e_in, push, push_eof, count, heads[FEAT], s_f, lcounts[0], lcounts[1], lovf,
                               base0=amap.features(0), base1=amap.features(1), always_urgent=False, **wkw))
-    insts.append(feature_in(clk, rst, feat, push, e_in, push_eof, count, s_f, depth=depth, capacity=feature_words))
+    insts.append(feature_in(clk, rst, feat, push, e_in, push_eof, count, depth=depth, capacity=feature_words))
 
     # ---- readers ------------------------------------------------------------------------------
     bases = ((amap.camera(0, 0), amap.camera(0, 1)), (amap.camera(1, 0), amap.camera(1, 1)))
@@ -424,7 +424,7 @@ def any_full(state, full):
 @block
 def stat_mux(clk, stat, words, waits, clocks, sides, rect_lost, lcounts, lovf):
     """The status port: the word at ``stat.addr`` (register map ``STAT`` in
-    eyestereo.tools.models.sram_arbiter) registered onto ``stat.data``."""
+    eyestereo.tools.models.sram_arbiter) on ``stat.data`` two clocks later."""
     s0, s1, s2, s3 = sides
     l0, l1 = lcounts
     pad = Signal(intbv(0)[31 - len(l0):])  # never driven: constant 0
@@ -450,53 +450,70 @@ def stat_mux(clk, stat, words, waits, clocks, sides, rect_lost, lcounts, lovf):
         f7.next = concat(ovf0, pad, l0)
         f8.next = concat(ovf1, pad, l1)
 
+    g0, g1, g2 = (Signal(intbv(0)[32:]) for _ in range(3))
+    grp = Signal(intbv(0)[2:])
+    lo3 = Signal(intbv(0)[3:])
+    hi = Signal(intbv(0)[len(stat.addr) - 3:])
+
+    @always_comb
+    def split():
+        lo3.next = stat.addr[3:0]
+        hi.next = stat.addr[len(stat.addr):3]
+
+    # two registered stages: eight words per group, then the group (the counters' wide multiplexer
+    # would otherwise be the longest path of the arbiter)
     @always(clk.posedge)
-    def read():
-        if stat.addr == 0:
-            stat.data.next = w0
-        elif stat.addr == 1:
-            stat.data.next = w1
-        elif stat.addr == 2:
-            stat.data.next = w2
-        elif stat.addr == 3:
-            stat.data.next = w3
-        elif stat.addr == 4:
-            stat.data.next = w4
-        elif stat.addr == 5:
-            stat.data.next = w5
-        elif stat.addr == 6:
-            stat.data.next = t0
-        elif stat.addr == 7:
-            stat.data.next = t1
-        elif stat.addr == 8:
-            stat.data.next = t2
-        elif stat.addr == 9:
-            stat.data.next = t3
-        elif stat.addr == 10:
-            stat.data.next = t4
-        elif stat.addr == 11:
-            stat.data.next = t5
-        elif stat.addr == 12:
-            stat.data.next = clocks
-        elif stat.addr == 13:
-            stat.data.next = f0
-        elif stat.addr == 14:
-            stat.data.next = f1
-        elif stat.addr == 15:
-            stat.data.next = f2
-        elif stat.addr == 16:
-            stat.data.next = f3
-        elif stat.addr == 17:
-            stat.data.next = f4
-        elif stat.addr == 18:
-            stat.data.next = f5
-        elif stat.addr == 19:
-            stat.data.next = f6
-        elif stat.addr == 20:
-            stat.data.next = f7
-        elif stat.addr == 21:
-            stat.data.next = f8
+    def stage1():
+        if hi == 0:
+            grp.next = 0
+        elif hi == 1:
+            grp.next = 1
+        elif hi == 2:
+            grp.next = 2
+        else:
+            grp.next = 3
+        if lo3 == 0:
+            g0.next = w0
+            g1.next = t2
+            g2.next = f3
+        elif lo3 == 1:
+            g0.next = w1
+            g1.next = t3
+            g2.next = f4
+        elif lo3 == 2:
+            g0.next = w2
+            g1.next = t4
+            g2.next = f5
+        elif lo3 == 3:
+            g0.next = w3
+            g1.next = t5
+            g2.next = f6
+        elif lo3 == 4:
+            g0.next = w4
+            g1.next = clocks
+            g2.next = f7
+        elif lo3 == 5:
+            g0.next = w5
+            g1.next = f0
+            g2.next = f8
+        elif lo3 == 6:
+            g0.next = t0
+            g1.next = f1
+            g2.next = 0
+        else:
+            g0.next = t1
+            g1.next = f2
+            g2.next = 0
+
+    @always(clk.posedge)
+    def stage2():
+        if grp == 0:
+            stat.data.next = g0
+        elif grp == 1:
+            stat.data.next = g1
+        elif grp == 2:
+            stat.data.next = g2
         else:
             stat.data.next = 0
 
-    return fields, lists, read
+    return fields, lists, split, stage1, stage2

@@ -173,11 +173,12 @@ class HostPort:
 
 class StatPort:
     """Read port of the arbiter's counters and frame-buffer status: ``addr`` in, ``data`` (32 bits) out
-    one clock later (a registered multiplexer; the register map is the arbiter's docstring)::
+    two clocks later (a two-stage registered multiplexer; the register map is ``STAT`` in
+    eyestereo.tools.models.sram_arbiter)::
 
-        cycle  0    1    2
-        addr   a0   a1   .
-        data   .    d0   d1
+        cycle  0    1    2    3
+        addr   a0   a1   .    .
+        data   .    .    d0   d1
     """
 
     def __init__(self, addr_bits: int = 5, data_bits: int = 32):

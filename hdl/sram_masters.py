@@ -23,9 +23,9 @@ from eyestereo.hdl.common.arith import shift_add
 from eyestereo.hdl.common.fifo import sync_fifo
 from eyestereo.tools.sram import ADDR_BITS, DATA_BITS
 
-# FIFO entry of the writers: data (16), sof (16), eof (17), buffer (18), list overflow (19)
+# FIFO entry of the writers: data (15..0), sof (16), eof (17), list overflow (18), abort (19)
 ENTRY_BITS = DATA_BITS + 4
-SOF, EOF, BUF, OVF = DATA_BITS, DATA_BITS + 1, DATA_BITS + 2, DATA_BITS + 3
+SOF, EOF, OVF, ABT = DATA_BITS, DATA_BITS + 1, DATA_BITS + 2, DATA_BITS + 3
 
 
 class Head:
@@ -51,52 +51,54 @@ class Head:
 
 # ------------------------------------------------------------------------------------------------------
 @block
-def writer_issue(clk, rst, entry, count, pop, push_eof, head, side, lcount0, lcount1, lovf,
+def writer_issue(clk, rst, entry, valid, count, pop, push_eof, head, side, lcount0, lcount1, lovf,
                  *, base0: int, base1: int, depth: int, burst: int, urgent_level: int, always_urgent: bool):
-    """The SRAM side of a writer: its FIFO's head word to consecutive addresses of its buffer.
+    """The SRAM side of a writer: its FIFO's words to consecutive addresses of a buffer, frame by frame.
 
-    The word flagged ``sof`` goes to the buffer's base address, the others follow it; issuing the word
-    flagged ``eof`` publishes the buffer (``side.p_done``) and records the frame's word count
-    (``lcount0``/``lcount1`` for buffer 0/1) and overflow flag (``lovf`` bit per buffer).
+    A frame's first word (``sof``) takes a buffer from the double buffer when it reaches the head of the
+    FIFO, i.e. after the previous frame's last word was issued and published, so back-to-back frames
+    find their buffer (this costs one clock per frame). If none is free the frame is dropped: its words
+    leave the FIFO without an access. Then the words go to the buffer's base address and on; issuing
+    the word flagged ``eof`` publishes the buffer (``side.p_done``) and records the frame's word count
+    (``lcount0``/``lcount1``) and overflow flag (``lovf``). An abort entry (a reset token) abandons the
+    frame (``side.p_abort``).
     """
     waddr = Signal(intbv(0)[ADDR_BITS:])
-    eofs = Signal(intbv(0, min=0, max=depth + 1))  # eof words in the FIFO
+    eofs = Signal(intbv(0, min=0, max=depth + 1))  # entries with eof in the FIFO (frame ends, aborts)
     nwords = Signal(intbv(0)[len(lcount0):])       # words of the current frame issued so far
-    sof = Signal(bool(0))
-    eof = Signal(bool(0))
-    buf = Signal(bool(0))
-    ovf = Signal(bool(0))
+    sof, eof, ovf, abt = (Signal(bool(0)) for _ in range(4))
     has = Signal(bool(0))
+    claim = Signal(bool(0))
+    claimed = Signal(bool(0))
+    cur = Signal(bool(0))
+    discard = Signal(bool(0))
+    popped_eof = Signal(bool(0))
     cmax = (1 << len(lcount0)) - 1
 
     @always_comb
     def fields():
         sof.next = entry[SOF]
         eof.next = entry[EOF]
-        buf.next = entry[BUF]
         ovf.next = entry[OVF]
+        abt.next = entry[ABT]
         head.wdata.next = entry[DATA_BITS:0]
+        head.addr.next = waddr
 
     @always_comb
     def present():
-        has.next = count != 0
-        head.req.next = count != 0
+        h = valid
+        has.next = h
+        claim.next = h and sof and not claimed and not abt and not discard
+        head.req.next = h and not abt and not discard and (claimed or not sof)
         head.we.next = True
         head.be.next = 3
         head.idx.next = 0
-        if sof:
-            if buf:
-                head.addr.next = base1
-            else:
-                head.addr.next = base0
-        else:
-            head.addr.next = waddr
-
-    @always_comb
-    def handshake():
-        pop.next = head.grant
+        # entries that leave the FIFO without an access: aborts, a dropped frame's words
+        pop.next = head.grant or (h and (abt or discard or side.p_deny))
         side.p_done.next = head.grant and eof
-        side.p_done_buf.next = buf
+        side.p_done_buf.next = cur
+        side.p_abort.next = h and abt and claimed
+        side.p_abort_buf.next = cur
 
     @always_seq(clk.posedge, reset=rst)
     def track():
@@ -107,14 +109,33 @@ def writer_issue(clk, rst, entry, count, pop, push_eof, head, side, lcount0, lco
             head.urgent.next = wants
         else:
             head.urgent.next = count >= urgent_level
+        # a frame's first word at the head asks the double buffer for a buffer (answered a clock later)
+        if side.p_grant:
+            side.p_start.next = False
+            claimed.next = True
+            cur.next = side.p_gbuf
+            if side.p_gbuf:
+                waddr.next = base1
+            else:
+                waddr.next = base0
+        elif side.p_deny:
+            side.p_start.next = False
+            discard.next = not eof
+        else:
+            side.p_start.next = claim
+        if discard and has and (eof or abt):
+            discard.next = False
+        if has and abt:
+            claimed.next = False
         if head.grant:
-            waddr.next = head.addr + 1
+            waddr.next = waddr + 1
             if sof:
                 nwords.next = 1
             elif nwords != cmax:
                 nwords.next = nwords + 1
             if eof:
-                if buf:
+                claimed.next = False
+                if cur:
                     if sof:
                         lcount1.next = 1
                     elif nwords != cmax:
@@ -126,58 +147,54 @@ def writer_issue(clk, rst, entry, count, pop, push_eof, head, side, lcount0, lco
                     elif nwords != cmax:
                         lcount0.next = nwords + 1
                     lovf.next[0] = ovf
-        if push_eof and not (head.grant and eof):
+        # (the count of eof entries follows the pops a clock late: it only feeds the start flag)
+        popped_eof.next = pop and eof
+        if push_eof and not popped_eof:
             eofs.next = eofs + 1
-        elif head.grant and eof and not push_eof:
+        elif popped_eof and not push_eof:
             eofs.next = eofs - 1
 
-    return fields, present, handshake, track
+    return fields, present, track
 
 
 # ------------------------------------------------------------------------------------------------------
 @block
-def camera_in(clk, rst, q, push, entry_in, push_eof, count, side, run, arm, *, depth: int):
-    """A camera's queue read port into the writer FIFO, one frame per buffer.
+def camera_in(clk, rst, q, push, entry_in, push_eof, count, run, arm, *, depth: int):
+    """A camera's queue read port into the writer FIFO.
 
-    A frame is captured when it starts while ``run`` is high or the camera is armed (``arm`` pulse, used
-    up by the next frame captured) and its double buffer has a buffer free; otherwise its words are
-    taken and discarded. A reset token (``eof`` without ``eol``) abandons the frame in progress (its
-    buffer goes back to FREE). ``ready`` comes from the FIFO count register only.
+    A frame is captured when it starts while ``run`` is high or the camera is armed (an ``arm`` pulse,
+    used up by the next frame captured); otherwise its words are taken and discarded. A reset token
+    (``eof`` without ``eol``) in a captured frame becomes an abort entry. ``ready`` comes from the FIFO
+    count register only.
     """
     take = Signal(bool(0))
     token = Signal(bool(0))
     first = Signal(bool(0))
-    capture = Signal(bool(0))
+    want = Signal(bool(0))
     in_frame = Signal(bool(0))
     cap = Signal(bool(0))
-    cur = Signal(bool(0))
     armed = Signal(bool(0))
-    bufsel = Signal(bool(0))
     zero = Signal(bool(0))  # never driven: a constant 0
 
     @always_comb
     def decide():
         q.ready.next = count != depth
         t = q.valid and count != depth
+        tok = t and q.eof and not q.eol
         take.next = t
-        token.next = t and q.eof and not q.eol
-        first.next = t and not in_frame and not (q.eof and not q.eol)
-        side.p_start.next = t and not in_frame and not (q.eof and not q.eol) and (run or armed)
-        capture.next = t and not in_frame and not (q.eof and not q.eol) and (run or armed) and side.p_avail
-        side.p_abort.next = t and q.eof and not q.eol and in_frame and cap
-        side.p_abort_buf.next = cur
+        token.next = tok
+        first.next = t and not in_frame and not tok
+        want.next = run or armed
+        if in_frame:
+            push.next = t and cap
+            push_eof.next = t and cap and q.eof
+        else:
+            push.next = t and not tok and (run or armed)
+            push_eof.next = t and not tok and (run or armed) and q.eof
 
     @always_comb
-    def store():
-        if in_frame:
-            bufsel.next = cur
-            push.next = take and not token and cap
-            push_eof.next = take and not token and cap and q.eof
-        else:
-            bufsel.next = side.p_pick
-            push.next = capture
-            push_eof.next = capture and q.eof
-        entry_in.next = concat(zero, bufsel, q.eof, first, q.data)
+    def pack():
+        entry_in.next = concat(token, zero, q.eof, first, q.data)
 
     @always_seq(clk.posedge, reset=rst)
     def frames():
@@ -187,130 +204,99 @@ def camera_in(clk, rst, q, push, entry_in, push_eof, count, side, run, arm, *, d
             in_frame.next = False
         elif take:
             if first:
-                cap.next = capture
-                cur.next = side.p_pick
-                if capture and not arm:
+                cap.next = want
+                if want and not arm:
                     armed.next = False
                 in_frame.next = not q.eof
             elif q.eof:
                 in_frame.next = False
 
-    return decide, store, frames
+    return decide, pack, frames
 
 
 # ------------------------------------------------------------------------------------------------------
 @block
-def rect_in(clk, rst, s, push, entry_in, push_eof, count, side, overflows, *, depth: int):
+def rect_in(clk, rst, s, push, entry_in, push_eof, count, overflows, *, depth: int):
     """The stereo image stream (8-bit, ``cam``) into the writer FIFO: one word per (x, y), left pixel in
-    bits 7..0, right pixel in 15..8, pushed with the right pixel's beat. Every frame is captured when a
-    buffer is free (else dropped, counted). The stream cannot wait: a word that finds the FIFO full is
-    lost and counted in ``overflows`` (the arbiter's priorities keep it at 0). A reset token abandons
-    the frame in progress.
+    bits 7..0, right pixel in 15..8, pushed with the right pixel's beat; every frame is captured. The
+    stream cannot wait: a word that finds the FIFO full is lost and counted in ``overflows`` (the
+    arbiter's priorities keep it at 0). A reset token inside a frame becomes an abort entry.
     """
     left = Signal(intbv(0)[8:])
-    pair = Signal(bool(0))
     token = Signal(bool(0))
-    first = Signal(bool(0))
-    capture = Signal(bool(0))
+    pair = Signal(bool(0))
     in_frame = Signal(bool(0))
-    cap = Signal(bool(0))
-    cur = Signal(bool(0))
-    bufsel = Signal(bool(0))
-    keep = Signal(bool(0))
+    want = Signal(bool(0))
+    rfirst = Signal(bool(0))
     zero = Signal(bool(0))  # never driven: a constant 0
 
     @always_comb
     def decide():
-        token.next = s.valid and s.eof and not s.eol
-        pair.next = s.valid and s.cam and not (s.eof and not s.eol)
-        first.next = s.valid and s.cam and not (s.eof and not s.eol) and not in_frame
-        side.p_start.next = s.valid and s.cam and not (s.eof and not s.eol) and not in_frame
-        capture.next = s.valid and s.cam and not (s.eof and not s.eol) and not in_frame and side.p_avail
-        side.p_abort.next = s.valid and s.eof and not s.eol and in_frame and cap
-        side.p_abort_buf.next = cur
+        tok = s.valid and s.eof and not s.eol
+        pr = s.valid and s.cam and not tok
+        token.next = tok
+        pair.next = pr
+        w = pr or (tok and in_frame)
+        want.next = w
+        push.next = w and count != depth
+        push_eof.next = w and count != depth and s.eof
+        rfirst.next = pr and not in_frame
 
     @always_comb
-    def store():
-        if in_frame:
-            bufsel.next = cur
-            keep.next = pair and cap
-            push.next = pair and cap and count != depth
-            push_eof.next = pair and cap and count != depth and s.eof
-        else:
-            bufsel.next = side.p_pick
-            keep.next = capture
-            push.next = capture and count != depth
-            push_eof.next = capture and count != depth and s.eof
-        entry_in.next = concat(zero, bufsel, s.eof, first, s.data, left)
+    def pack():
+        entry_in.next = concat(token, zero, s.eof, rfirst, s.data, left)
 
     @always_seq(clk.posedge, reset=rst)
     def frames():
         if s.valid and not s.cam and not (s.eof and not s.eol):
             left.next = s.data
-        if keep and count == depth:
+        if want and count == depth:
             overflows.next = overflows + 1
         if token:
             in_frame.next = False
         elif pair:
-            if first:
-                cap.next = capture
-                cur.next = side.p_pick
-                in_frame.next = not s.eof
-            elif s.eof:
-                in_frame.next = False
+            in_frame.next = not s.eof
 
-    return decide, store, frames
+    return decide, pack, frames
 
 
 # ------------------------------------------------------------------------------------------------------
 @block
-def feature_in(clk, rst, q, push, entry_in, push_eof, count, side, *, depth: int, capacity: int):
+def feature_in(clk, rst, q, push, entry_in, push_eof, count, *, depth: int, capacity: int):
     """Feature-list words (queue read port) into the writer FIFO, one list per buffer, ``eof`` on a
     list's last word. A list longer than the buffer's ``capacity`` keeps its first ``capacity - 1``
-    words and its last one, and is flagged as overflowed. Lists are captured whenever a buffer is free.
+    words and its last one, and is flagged as overflowed.
     """
     take = Signal(bool(0))
-    first = Signal(bool(0))
-    capture = Signal(bool(0))
     in_list = Signal(bool(0))
-    cap = Signal(bool(0))
-    cur = Signal(bool(0))
-    bufsel = Signal(bool(0))
     n = Signal(intbv(0, min=0, max=capacity + 1))  # words of the list taken (saturating)
     ovf = Signal(bool(0))
-    room = Signal(bool(0))
+    room = Signal(bool(0))  # the next word (if not the last) still has a slot: n < capacity - 1
+    ffirst = Signal(bool(0))
+    zero = Signal(bool(0))  # never driven: a constant 0
 
     @always_comb
     def decide():
         q.ready.next = count != depth
         t = q.valid and count != depth
         take.next = t
-        first.next = t and not in_list
-        side.p_start.next = t and not in_list
-        capture.next = t and not in_list and side.p_avail
-        side.p_abort.next = False
-        side.p_abort_buf.next = cur
+        if in_list:
+            push.next = t and (room or q.eof)
+            push_eof.next = t and q.eof
+        else:
+            push.next = t
+            push_eof.next = t and q.eof
+        ffirst.next = t and not in_list
 
     @always_comb
-    def store():
-        if in_list:
-            bufsel.next = cur
-            push.next = take and cap and (room or q.eof)
-            push_eof.next = take and cap and q.eof
-        else:
-            bufsel.next = side.p_pick
-            push.next = capture
-            push_eof.next = capture and q.eof
-        entry_in.next = concat(ovf, bufsel, q.eof, first, q.data)
+    def pack():
+        entry_in.next = concat(zero, ovf, q.eof, ffirst, q.data)
 
     @always_seq(clk.posedge, reset=rst)
     def lists():
-        # room: the word taken next (not the list's last) still has a slot: n < capacity - 1, kept in a
-        # register so that no comparator sits in the push path
+        # room kept in a register, so that no comparator sits in the push path
         if take:
-            if first:
-                cap.next = capture
-                cur.next = side.p_pick
+            if not in_list:
                 in_list.next = not q.eof
                 n.next = 1
                 room.next = capacity > 2
@@ -324,7 +310,7 @@ def feature_in(clk, rst, q, push, entry_in, push_eof, count, side, *, depth: int
                 if q.eof:
                     in_list.next = False
 
-    return decide, store, lists
+    return decide, pack, lists
 
 
 # ------------------------------------------------------------------------------------------------------
@@ -506,7 +492,8 @@ def frame_writer(clk, rst, entry_in, push, push_eof, count, head, side, lcount0,
     (:func:`camera_in`, :func:`rect_in`, :func:`feature_in`) pushes ``entry_in``."""
     entry = Signal(intbv(0)[ENTRY_BITS:])
     pop = Signal(bool(0))
-    fifo = sync_fifo(clk, rst, entry_in, push, entry, pop, count, depth=depth)
-    issue = writer_issue(clk, rst, entry, count, pop, push_eof, head, side, lcount0, lcount1, lovf, base0=base0,
+    valid = Signal(bool(0))
+    fifo = sync_fifo(clk, rst, entry_in, push, entry, pop, count, valid, depth=depth)
+    issue = writer_issue(clk, rst, entry, valid, count, pop, push_eof, head, side, lcount0, lcount1, lovf, base0=base0,
                          base1=base1, depth=depth, burst=burst, urgent_level=urgent_level, always_urgent=always_urgent)
     return fifo, issue

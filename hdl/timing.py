@@ -75,7 +75,9 @@ def analyse(netlist: dict, top: str) -> dict:
         if t in SEQ or t == "BUFG":
             return DELAY["CKO"], (cn,)
         if k == "RAM" and port in ("SPO", "DPO"):
-            ins = [b for p, b in sinks[cn] if p.startswith(("A", "DPRA"))]
+            # asynchronous read: SPO from the write address A*, DPO from the read address DPRA*
+            pre = "DPRA" if port == "DPO" else "A"
+            ins = [b for p, b in sinks[cn] if p.startswith(pre) and not (pre == "A" and p.startswith("ADDR"))]
             best = max((arrival(b) for b in ins), default=(0.0, ()))
             return best[0] + NET + DELAY["RAM"], best[1] + (cn,)
         best = (0.0, ())

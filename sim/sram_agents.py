@@ -64,6 +64,7 @@ class CameraSource:
         self.enabled = True
         self.stopping = False
         self.offered = False
+        self.limit = None  # frames to send (None: endless)
 
     def stop(self) -> None:
         """Finish the frame in progress, then send nothing more."""
@@ -71,8 +72,8 @@ class CameraSource:
 
     @property
     def idle(self) -> bool:
-        return not self.fifo and self.valid.v == 0 and (
-            not self.enabled or (self.stopping and self.pos in (0, self.w * self.h)))
+        done = self.stopping or (self.limit is not None and len(self.frames) >= self.limit)
+        return not self.fifo and self.valid.v == 0 and (not self.enabled or (done and self.pos in (0, self.w * self.h)))
 
     def _new_frame(self):
         self.frames.append([self.rng.randrange(1 << 16) for _ in range(self.w * self.h)])
@@ -88,7 +89,7 @@ class CameraSource:
         while self.acc >= 1.0:
             self.acc -= 1.0
             if not self.frames or self.pos == self.w * self.h:
-                if self.stopping:
+                if self.stopping or (self.limit is not None and len(self.frames) >= self.limit):
                     self.acc = 0.0
                     return
                 self._new_frame()
@@ -347,6 +348,7 @@ class HostMaster:
         self.offer = None
         self.accesses = 0
         self.area_reads = 0
+        self.job_rate = 1.0  # probability of issuing the next whole-buffer read in a clock
 
     def read_buffer(self, addrs) -> None:
         self.jobs.extend(addrs)
@@ -386,7 +388,7 @@ class HostMaster:
     def drive(self, clock: int) -> None:
         if self.offer is not None:
             return
-        if self.jobs:
+        if self.jobs and self.rng.random() < self.job_rate:
             self.offer = (0, self.jobs.popleft(), 0, 3, "buffer")
         elif self.rng.random() < self.duty:
             we = self.rng.random() < self.write_share

