@@ -21,7 +21,7 @@ from eyestereo.hdl.prethreshold import prethreshold
 from eyestereo.hdl.line_delay import line_delay
 from eyestereo.hdl.sobel import sobel
 from eyestereo.hdl.fetch_port import FetchPort
-from eyestereo.hdl.frame_buffers import FrameControl
+from eyestereo.hdl.frame_buffers import BufferSide, FrameControl, double_buffer
 from eyestereo.hdl.queue_port import QueuePort
 from eyestereo.hdl.sram_arbiter import TAG_BITS, sram_arbiter
 from eyestereo.hdl.sram_bus import HostPort, SramCmd, SramPins, SramRsp, StatPort
@@ -172,6 +172,10 @@ BLOCKS["sram_subsystem"] = BlockSpec(
     "sram_subsystem", "sram_arbiter + sram_controller: the SRAM's pins and the six masters' ports",
     sram_subsystem, dict(_ARB, kind="nobl", read_latency=2), hw_params=tuple(_ARB) + ("kind", "read_latency"),
     ports=lambda p: dict(_clk_rst(), **_masters(p), sram=SramPins()))
+
+BLOCKS["double_buffer"] = BlockSpec(
+    "double_buffer", "frame handshake of one producer's two SRAM buffers (FREE/WRITING/FULL/READING)",
+    double_buffer, dict(), ports=lambda p: dict(_clk_rst(), side=BufferSide()))
 
 
 def get(name: str) -> BlockSpec:

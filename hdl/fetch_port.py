@@ -28,18 +28,19 @@ wait clocks. The master takes every beat; it must be able to hold the responses 
 outstanding. The slave may take further requests before earlier ones are answered (pipelining);
 responses never overtake.
 
-Timing of two requests, mask 1111 and 0101, as the SRAM arbiter answers them with nothing else going
-on (``#`` high, ``_`` low, ``.`` don't care; the second request waits one clock for ``req_ready``)::
+Timing of two requests, mask 1111 and 0101, as the SRAM arbiter answers them on a quiet bus (part of
+read latency 2; ``#`` high, ``_`` low, ``.`` don't care; the arbiter takes a request every other clock,
+the first pixel comes 11 clocks after its request is taken, then one per clock)::
 
-    cycle      0    1    2    3    4    5    6    7    8    9   10   11   12   13
-    req_valid  #    #    #    _    _    _    _    _    _    _    _    _    _    _
-    req_ready  #    _    #    _    #    #    #    #    #    #    #    #    #    #
-    req_mask   1111 0101 0101 .    .    .    .    .    .    .    .    .    .    .
-    rsp_valid  _    _    _    _    _    _    _    _    _    #    #    #    #    #
-    rsp_idx    .    .    .    .    .    .    .    .    .    0    1    2    3    0   then 2 in cycle 14
+    cycle      0    1    2    3   ..   10   11   12   13   14   15   16   17
+    req_valid  #    #    #    _   ..   _    _    _    _    _    _    _    _
+    req_ready  #    _    #    _   ..   #    #    #    #    #    #    #    #
+    req_mask   1111 0101 0101 .   ..   .    .    .    .    .    .    .    .
+    rsp_valid  _    _    _    _   ..   _    #    #    #    #    #    #    _
+    rsp_idx    .    .    .    .   ..   .    0    1    2    3    0    2    .
 
-The arbiter's own latency from a request to its first pixel depends on the part and the load; the
-benches measure it (docs/sram.md).
+Under load the arbiter adds wait clocks anywhere between the beats; docs/sram.md has the measured
+latencies.
 """
 
 from __future__ import annotations

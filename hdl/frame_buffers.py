@@ -139,13 +139,16 @@ def double_buffer(clk, rst, side: BufferSide):
     s1 = Signal(intbv(FREE)[2:])
     newest = Signal(bool(0))
     take_buf = Signal(bool(0))
+    # internal copies of the outputs the block reads back (VHDL-93 cannot read an out port)
+    c_avail, c_held, c_buf, p_avail, p_pick, p_grant, p_gbuf, p_deny = (Signal(bool(0)) for _ in range(8))
+    published, dropped, overwritten = (Signal(intbv(0)[COUNT_BITS:]) for _ in range(3))
 
     @always_comb
     def consumer_choice():
         # the newest FULL buffer (or the other one if only it is FULL)
         full0 = s0 == FULL
         full1 = s1 == FULL
-        side.c_avail.next = (full0 or full1) and not side.c_held
+        c_avail.next = (full0 or full1) and not c_held
         if full0 and full1:
             take_buf.next = newest
         else:
@@ -153,18 +156,18 @@ def double_buffer(clk, rst, side: BufferSide):
 
     @always_comb
     def producer_choice():
-        taking = side.c_take and side.c_avail
+        taking = side.c_take and c_avail
         ok0 = (s0 == FREE or s0 == FULL) and not (taking and not take_buf)
         ok1 = (s1 == FREE or s1 == FULL) and not (taking and take_buf)
-        side.p_avail.next = ok0 or ok1
+        p_avail.next = ok0 or ok1
         if ok0 and ok1:
             # both FREE or both FULL: the one that is not the newest; one FREE: that one
             if s0 == s1:
-                side.p_pick.next = not newest
+                p_pick.next = not newest
             else:
-                side.p_pick.next = s1 == FREE
+                p_pick.next = s1 == FREE
         else:
-            side.p_pick.next = ok1
+            p_pick.next = ok1
 
     @always_comb
     def status():
@@ -172,26 +175,26 @@ def double_buffer(clk, rst, side: BufferSide):
 
     @always_seq(clk.posedge, reset=rst)
     def update():
-        taking = side.c_take and side.c_avail
-        asking = side.p_start and not side.p_grant and not side.p_deny  # not the clock it was answered
-        starting = asking and side.p_avail
-        side.p_grant.next = starting
-        side.p_deny.next = asking and not side.p_avail
-        side.p_gbuf.next = side.p_pick
+        taking = side.c_take and c_avail
+        asking = side.p_start and not p_grant and not p_deny  # not the clock it was answered
+        starting = asking and p_avail
+        p_grant.next = starting
+        p_deny.next = asking and not p_avail
+        p_gbuf.next = p_pick
         # producer
         if starting:
-            if side.p_pick:
+            if p_pick:
                 if s1 == FULL:
-                    side.overwritten.next = side.overwritten + 1
+                    overwritten.next = overwritten + 1
                 s1.next = WRITING
             else:
                 if s0 == FULL:
-                    side.overwritten.next = side.overwritten + 1
+                    overwritten.next = overwritten + 1
                 s0.next = WRITING
-        if asking and not side.p_avail:
-            side.dropped.next = side.dropped + 1
+        if asking and not p_avail:
+            dropped.next = dropped + 1
         if side.p_done:
-            side.published.next = side.published + 1
+            published.next = published + 1
             newest.next = side.p_done_buf
             if side.p_done_buf:
                 s1.next = FULL
@@ -203,18 +206,32 @@ def double_buffer(clk, rst, side: BufferSide):
             else:
                 s0.next = FREE
         # consumer
-        if side.c_release and side.c_held:
-            side.c_held.next = False
-            if side.c_buf:
+        if side.c_release and c_held:
+            c_held.next = False
+            if c_buf:
                 s1.next = FREE
             else:
                 s0.next = FREE
         elif taking:
-            side.c_held.next = True
-            side.c_buf.next = take_buf
+            c_held.next = True
+            c_buf.next = take_buf
             if take_buf:
                 s1.next = READING
             else:
                 s0.next = READING
 
-    return consumer_choice, producer_choice, status, update
+    @always_comb
+    def outputs():
+        side.c_avail.next = c_avail
+        side.c_held.next = c_held
+        side.c_buf.next = c_buf
+        side.p_avail.next = p_avail
+        side.p_pick.next = p_pick
+        side.p_grant.next = p_grant
+        side.p_gbuf.next = p_gbuf
+        side.p_deny.next = p_deny
+        side.published.next = published
+        side.dropped.next = dropped
+        side.overwritten.next = overwritten
+
+    return consumer_choice, producer_choice, status, update, outputs

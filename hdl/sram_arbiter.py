@@ -46,23 +46,24 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     of the same (x, y) packed into one word); 4 ``feat`` -- the feature-list writer (queue read port of
     16-bit words, ``eof`` on a list's last word); 5 ``host`` -- the host port (reads and writes).
 
-    Arbitration, one access per clock: the master holding the bus keeps it for up to its burst length
-    while it has accesses (writers: ``burst``; fetch: ``fetch_burst`` reads, i.e. whole requests; host:
-    ``host_burst``). Then the next master is chosen round robin from the one after the last to start a
-    turn, among the *urgent* masters if any, else among all that ask for a turn. Camera writers are
-    always urgent when they ask (they ask when ``burst`` words or a frame's end wait in their FIFO), and
-    an urgent master takes the bus from a non-urgent one at the next clock; the rectified writer becomes
-    urgent when its FIFO is 3/4 full. So a camera waits at most for the other camera's burst and the
-    bus turnaround, whatever the rest does, and every master is served within one round: no
-    starvation. On a pipelined SyncBurst part the controller holds a write back during the turnaround;
-    the turn is kept meanwhile, so a stream of reads cannot starve a write.
+    Arbitration, one access per clock: the master owning the bus issues one access per clock while it
+    has one, for up to its burst length (writers: ``burst``; fetch: ``fetch_burst`` reads, i.e. whole
+    requests; host: ``host_burst``). The next owner is chosen a clock ahead, round robin from the one
+    after the current owner, among the *urgent* masters if any, else among all that ask for a turn.
+    Writers ask when ``burst`` words or a frame's end wait in their FIFO; camera writers are then always
+    urgent, the rectified writer when its FIFO is 3/4 full; an urgent master ends a non-urgent turn at
+    the next clock. So a camera waits at most for the other camera's burst and the bus turnaround,
+    whatever the rest does, and every master is served within one round: no starvation. On a pipelined
+    SyncBurst part the controller holds a write back during the turnaround; the turn is kept meanwhile,
+    so a stream of reads cannot starve a write. The owner, the next owner and the command to the
+    controller are registers: between flip-flops there are at most a few LUT levels (docs/sram.md).
 
     Frame buffers (hdl/frame_buffers.py): each writer has two buffers (address map:
     :class:`eyestereo.tools.models.sram_arbiter.AddressMap`) and a :func:`double_buffer` state; the system's
     controller drives the :class:`FrameControl` handshake. The fetch port reads the camera buffers held
     by ``cam_want``/``cam_held``.
 
-    Status port (``stat``): address -> 32-bit word, one clock later: 0..5 words moved per master,
+    Status port (``stat``): address -> 32-bit word, two clocks later: 0..5 words moved per master,
     6..11 clocks each master waited (it asked or held a turn and was not granted), 12 clocks since
     reset, 13..18 frames published / dropped / overwritten per double buffer, 19 buffer states and the
     rectified writer's lost words, 20..21 the feature lists' word counts (``STAT`` in the model module).
@@ -83,12 +84,12 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
         width, height: frame size of the camera and rectified buffers (2..4096; the map must fit).
         feature_words: capacity of each feature-list buffer (2..65536).
         depth: writer FIFO depth (8, 16 or 32 words of LUT-RAM).
-        burst: writer burst length (2..depth/2), fetch_burst (4..16), host_burst (1..8).
+        burst: writer burst length (2..depth/2), fetch_burst (4..16), host_burst (1..8, default 1).
         counter_bits: width of the words-moved and clocks-waited counters (16..32).
 
-    Latency: a fetch request's first pixel comes read_latency + 6 clocks after it is taken when the bus
-    is free (3 stages here, the controller's read_latency + 2, one output register); host reads
-    read_latency + 4.
+    Latency (measured, docs/sram.md): on a quiet bus with a part of read latency 2, a fetch request's
+    first pixel comes 11 clocks after the request is taken, a host read's word 7 clocks after; each
+    waits longer while other masters hold the bus.
 
     Resources: see docs/sram.md (Yosys, Spartan-3E).
     """
@@ -242,7 +243,7 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     urg = Signal(intbv(0)[NM:])
     pool = Signal(intbv(0)[NM:])
     cand = Signal(intbv(0)[NM:])
-    after = Signal(intbv(0)[NM:])
+    above = Signal(intbv(0)[NM:])
     AFTER = tuple(((1 << NM) - 1) & ~((1 << (k + 1)) - 1) for k in range(NM))  # masters above k
     gv = Signal(intbv(0)[NM:])
     wantv = Signal(intbv(0)[NM:])
@@ -263,12 +264,12 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
             pool.next = urg
         else:
             pool.next = startv
-        after.next = AFTER[own]
+        above.next = AFTER[own]
 
     @always_comb
     def masked():
-        if (pool & after) != 0:
-            cand.next = pool & after
+        if (pool & above) != 0:
+            cand.next = pool & above
         else:
             cand.next = pool
 

@@ -28,8 +28,8 @@ def sram_subsystem(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, sra
         width, height, feature_words, depth, burst, fetch_burst, host_burst, counter_bits: as
             :func:`sram_arbiter`.
 
-    Latency: a fetch request's first pixel read_latency + 6 clocks after it is taken on an idle bus;
-    a host read's data read_latency + 5 clocks after it is taken.
+    Latency: as :func:`sram_arbiter` (measured with a part of read latency 2: fetch 11 clocks to the
+    first pixel, host reads 7 clocks, on a quiet bus).
 
     Resources: see docs/sram.md.
     """

@@ -127,9 +127,10 @@ def latency_idle(kinds) -> list[dict]:
     out = []
     for kind in kinds:
         rep = run(kind, "latency", dict(seed=3, clocks=4000, cam_frames=1, cam_rate=0.5, rect=False, feat=False,
-                                        host_duty=0, fetch_mode="continuous", hold=True, fetch_duty=0.05))
-        lat = rep["fetch_latency"]
-        out.append(dict(kind=kind, min=min(lat), median=statistics.median(lat)))
+                                        host_duty=0.01, fetch_mode="continuous", hold=True, fetch_duty=0.02))
+        lat, hl = rep["fetch_latency"], rep["host_latency"]
+        out.append(dict(kind=kind, min=min(lat), median=statistics.median(lat), host_min=min(hl),
+                        host_median=statistics.median(hl)))
     return out
 
 
@@ -273,8 +274,10 @@ def report(res: dict) -> str:
         L.append("")
     li = res.get("latency", [])
     if li:
-        L += ["Fetch latency on an idle bus (request taken to its first pixel, clocks): " +
-              ", ".join(f"{x['kind']} {x['min']} (median {x['median']:.0f})" for x in li) + ".", ""]
+        L += ["Latency on a quiet bus, from the clock a request is taken to the clock its data comes back: fetch "
+              "(first pixel) " + ", ".join(f"{x['kind']} {x['min']} (median {x['median']:.0f})" for x in li) +
+              "; host read " + ", ".join(f"{x['kind']} {x['host_min']} (median {x['host_median']:.0f})" for x in li) +
+              " clocks.", ""]
     rs = res.get("resources", [])
     if rs:
         L += ["## Resources and clock", "",
@@ -304,7 +307,12 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default="docs/sram.md", type=Path)
     ap.add_argument("--quick", action="store_true", help="few seeds and short runs (a smoke test)")
     ap.add_argument("--json", type=Path, help="also write the raw results here")
+    ap.add_argument("--from-json", type=Path, help="only render the Markdown from raw results written earlier")
     args = ap.parse_args(argv)
+    if args.from_json:
+        args.out.write_text(report(json.loads(args.from_json.read_text())))
+        print(f"wrote {args.out}")
+        return 0
     q = args.quick
     res: dict = {}
     t0 = time.time()

@@ -349,6 +349,7 @@ class HostMaster:
         self.accesses = 0
         self.area_reads = 0
         self.job_rate = 1.0  # probability of issuing the next whole-buffer read in a clock
+        self.latency: list[int] = []  # clocks from a read taken to its data
 
     def read_buffer(self, addrs) -> None:
         self.jobs.extend(addrs)
@@ -356,7 +357,8 @@ class HostMaster:
     def sample(self, clock: int) -> None:
         if read_int(self.rsp_valid):
             assert self.expect, f"clock {clock}: a host response nobody asked for"
-            kind, addr, want = self.expect.popleft()
+            kind, addr, want, t0 = self.expect.popleft()
+            self.latency.append(clock - t0)
             data = read_int(self.rsp_data)
             assert data is not None, f"clock {clock}: host read data undefined"
             if kind == "area":
@@ -379,9 +381,9 @@ class HostMaster:
                 self.mem[addr] = old
             elif kind == "area":
                 from eyestereo.tools.sram import power_up_word
-                self.expect.append(("area", addr, self.mem.get(addr, power_up_word(addr))))
+                self.expect.append(("area", addr, self.mem.get(addr, power_up_word(addr)), clock))
             else:
-                self.expect.append(("buffer", addr, None))
+                self.expect.append(("buffer", addr, None, clock))
             self.offer = None
             self.valid.set(0)
 

@@ -376,5 +376,5 @@ async def subsystem_traffic(dut):
         fetch_requests=len(fetch.requests), fetch_reads=len(cam_reads), fetch_held_clocks=fetch_held_clocks,
         fetch_latency=[fetch.first_rsp[i] - fetch.requests[i][0] for i in sorted(fetch.first_rsp)][:2000],
         takes=ctl.takes, arms=ctl.arms, host_area_reads=host.area_reads, host_buffer_reads=len(host.buffer_reads),
-        measured=measured, cam_overflow=[bool(c.overflows) for c in cams])
+        measured=measured, cam_overflow=[bool(c.overflows) for c in cams], host_latency=host.latency[:2000])
     write_report(cfg, report)

@@ -125,3 +125,27 @@ def test_subsystem_bench_catches_early_release(request):
         _sub(request, dict(kind="nobl", read_latency=2),
              dict(seed=1, clocks=8000, early_release=True, fetch_duty=0.05))
     assert "half-written frame" in _failure_text(request, "sram_subsystem")
+
+
+# --- double_buffer against its clock-true model --------------------------------------------------------
+@pytest.mark.parametrize("seed,rate", [(1, 0.2), (2, 0.6)])
+def test_double_buffer_model(request, seed, rate):
+    rep = run_sram_bench("double_buffer", "tb_double_buffer", dict(seed=seed, clocks=3000, frame_rate=rate),
+                         name=request.node.name)
+    assert rep["grants"] > 20 and rep["takes"] > 5 and rep["published"] > 10
+    assert rep["denies"] + rep["overwritten"] > 0  # the contested cases happened
+
+
+@pytest.mark.parametrize("kind", ["nobl", "pipelined"])
+def test_subsystem_documented_latency(request, kind):
+    """On a quiet bus the fetch port's first pixel and a host read take the clocks the docstrings state."""
+    from eyestereo.hdl.fetch_port import __doc__ as fetch_doc
+    from eyestereo.hdl.sram_arbiter import sram_arbiter
+
+    doc = " ".join(sram_arbiter.__doc__.split())
+    assert "fetch request's first pixel comes 11 clocks after" in doc and "host read's word 7 clocks after" in doc
+    assert "the first pixel comes 11 clocks after its request is taken" in " ".join(fetch_doc.split())
+    rep = _sub(request, dict(kind=kind, read_latency=2),
+               dict(seed=3, clocks=3000, cam_frames=1, cam_rate=0.5, rect=False, feat=False, host_duty=0.01,
+                    fetch_mode="continuous", hold=True, fetch_duty=0.02))
+    assert min(rep["fetch_latency"]) == 11 and min(rep["host_latency"]) == 7

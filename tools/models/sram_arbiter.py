@@ -144,58 +144,75 @@ FREE, WRITING, FULL, READING = range(4)
 
 @dataclass
 class DoubleBufferModel:
-    """Reference model of one producer's two buffers (the rules of hdl/frame_buffers.py), event by event."""
+    """Clock-true model of :func:`eyestereo.hdl.frame_buffers.double_buffer`: call :meth:`clock` once per
+    rising edge with the inputs of the clock that edge ends; the attributes are then the registers.
+
+    The rules: a consumer's take (``c_take`` while a FULL buffer exists and none is held) takes the
+    newest FULL buffer and wins over a producer's request in the same clock; a producer's request
+    (``p_start``, held until answered) gets a FREE buffer if there is one, else the older FULL one (the
+    newest frame stays for the consumer), never one being written or read; it is answered a clock later
+    (``p_grant`` with ``p_gbuf``, or ``p_deny``: the frame is dropped).
+    """
 
     state: list = field(default_factory=lambda: [FREE, FREE])
     newest: int = 0
-    held: int | None = None
+    held: bool = False
+    buf: int = 0
+    p_grant: bool = False
+    p_gbuf: int = 0
+    p_deny: bool = False
     published: int = 0
     dropped: int = 0
     overwritten: int = 0
 
-    def pick(self, taking: int | None = None) -> int | None:
+    def c_avail(self) -> bool:
+        return FULL in self.state and not self.held
+
+    def take_choice(self) -> int:
+        full = [b for b in (0, 1) if self.state[b] == FULL]
+        return self.newest if len(full) == 2 else (full[0] if full else 0)
+
+    def pick(self, taking: int | None) -> int | None:
         ok = [b for b in (0, 1) if self.state[b] in (FREE, FULL) and b != taking]
-        if not ok:
-            return None
         if len(ok) == 2:
             if self.state[0] == self.state[1]:
                 return 1 - self.newest
             return 0 if self.state[0] == FREE else 1
-        return ok[0]
+        return ok[0] if ok else None
 
-    def take_choice(self) -> int | None:
-        full = [b for b in (0, 1) if self.state[b] == FULL]
-        if not full or self.held is not None:
-            return None
-        return self.newest if len(full) == 2 else full[0]
-
-    def start(self, taking: int | None = None) -> int | None:
-        b = self.pick(taking)
-        if b is None:
+    def clock(self, *, p_start=False, p_done=False, p_done_buf=0, p_abort=False, p_abort_buf=0, c_take=False,
+              c_release=False) -> None:
+        taking = c_take and self.c_avail()
+        tb = self.take_choice() if taking else None
+        asking = p_start and not self.p_grant and not self.p_deny
+        pick = self.pick(tb)
+        new = list(self.state)
+        starting = asking and pick is not None
+        self.p_grant, self.p_deny = starting, asking and pick is None
+        if pick is not None:
+            self.p_gbuf = pick
+        elif asking:
+            pass
+        if starting:
+            if self.state[pick] == FULL:
+                self.overwritten += 1
+            new[pick] = WRITING
+        if asking and pick is None:
             self.dropped += 1
-            return None
-        if self.state[b] == FULL:
-            self.overwritten += 1
-        self.state[b] = WRITING
-        return b
-
-    def done(self, b: int) -> None:
-        assert self.state[b] == WRITING, f"buffer {b} published while {BUFFER_STATES[self.state[b]]}"
-        self.state[b] = FULL
-        self.newest = b
-        self.published += 1
-
-    def take(self) -> int | None:
-        b = self.take_choice()
-        if b is not None:
-            self.state[b] = READING
-            self.held = b
-        return b
-
-    def release(self) -> None:
-        if self.held is not None:
-            self.state[self.held] = FREE
-            self.held = None
+        if p_done:
+            self.published += 1
+            self.newest = p_done_buf
+            new[p_done_buf] = FULL
+        if p_abort:
+            new[p_abort_buf] = FREE
+        if c_release and self.held:
+            self.held = False
+            new[self.buf] = FREE
+        elif taking:
+            self.held = True
+            self.buf = tb
+            new[tb] = READING
+        self.state = new
 
 
 # ------------------------------------------------------------------------------------------------------
