@@ -59,6 +59,7 @@ bench: setup
 	$(PY) -m eyestereo.tools.reports.harris_report --out docs/harris.md
 	$(PY) -m eyestereo.tools.reports.bench_ffc
 	$(PY) -m eyestereo.tools.reports.bench_matching --out docs/matching.md
+	$(PY) -m eyestereo.sim.bench_sram --out docs/sram.md
 
 clean:
 	rm -rf build .pytest_cache .hypothesis

@@ -287,8 +287,11 @@ async def subsystem_traffic(dut):
     wl, rl = model.chip.write_log, model.chip.read_log
     n = amap.frame
     cap = amap.feature_words
-    hist = {f"cam{c}": BufferHistory(f"camera {c}", (amap.camera(c, 0), amap.camera(c, 1)), n, wl, cams[c].frames)
-            for c in (0, 1)}
+    # (a camera FIFO that overflowed -- allowed only when measuring the margin -- lost words: its frames
+    # no longer match what was sent, so the camera data checks are skipped then; everything else holds)
+    lossy = any(c.overflows for c in cams)
+    hist = {f"cam{c}": BufferHistory(f"camera {c}", (amap.camera(c, 0), amap.camera(c, 1)), n,
+                                     [] if lossy else wl, cams[c].frames) for c in (0, 1)}
     hist["rect"] = BufferHistory("rectified", (amap.rectified(0), amap.rectified(1)), n, wl, stereo.sent)
 
     def stored_list(lst):
@@ -319,6 +322,8 @@ async def subsystem_traffic(dut):
         for i, (g, e) in enumerate(zip([a for _, a in cam_reads] + [None] * len(want), want)) if g != e)
     assert len(fetch.responses) == len(want), f"{len(fetch.responses)} fetch responses for {len(want)} reads"
     for i, ((e, a), (_, idx, data)) in enumerate(zip(cam_reads, fetch.responses)):
+        if lossy:
+            break
         k = region_of(a)
         expect = hist[k].word_at(e, a) & 0xFF
         assert data == expect, f"fetch response {i} (read of {a:#07x} at edge {e}): {data:#04x}, expected {expect:#04x}"
@@ -334,11 +339,13 @@ async def subsystem_traffic(dut):
     for i, m in enumerate(MASTERS):
         assert stat[i] == moved[m] & 0xFFFFFFFF, f"status word {i} ({STAT[i]}) is {stat[i]}, the bench counted {moved[m]}"
     for i, k in enumerate(("cam0", "cam1", "rect", "feat")):
+        if lossy and k in ("cam0", "cam1"):
+            continue
         published = stat[13 + i] & 0xFFFF
         complete = len(hist[k].complete_runs())
         assert published == complete, f"{k}: {published} frames published, {complete} complete in the SRAM"
     assert stat[19] >> 16 == 0, f"the rectified writer lost {stat[19] >> 16} words"
-    for k in ("cam0", "cam1"):
+    for k in ("cam0", "cam1")[:0 if lossy else 2]:
         runs = hist[k].runs
         assert not runs or runs[-1].complete, f"{k}: the last frame was not finished"
     if not cfg.get("allow_overflow"):
