@@ -9,7 +9,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-$(shell (cat pyproject.toml 2>/dev/null || echo none) | cksum | cut -d' ' -f1)
 JOBS   ?= 2
 
-.PHONY: all setup ghdl vhdl sim test demo synth bench clean distclean help
+.PHONY: all setup ghdl vhdl sim test demo synth timing report bench clean distclean help
 
 all: test
 
@@ -27,8 +27,10 @@ $(STAMP): pyproject.toml
 	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq python3-venv >/dev/null && \
 	    $(PYTHON) -m venv $(VENV); \
 	  else echo "error: cannot create a venv: install python3-venv (Debian: sudo apt-get install python3-venv)" >&2; exit 1; fi; }
-	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -e '.[dev]'
+	@mkdir -p build
+	@echo "installing eyestereo and its dev extras into $(VENV) (log: build/setup.log) ..."
+	@{ $(PY) -m pip install -q --upgrade pip && $(PY) -m pip install -q -e '.[dev]'; } > build/setup.log 2>&1 || \
+	  { tail -n 30 build/setup.log >&2; echo "error: the installation failed; see build/setup.log" >&2; exit 1; }
 	@rm -f $(VENV)/.installed-*
 	@touch $@
 
@@ -51,14 +53,33 @@ test: setup
 demo: setup
 	$(PY) -m eyestereo.sim.demo --out build/demo
 
+# GHDL's netlist of every block's VHDL -> Yosys (Spartan-3E resources) and nextpnr-ecp5 (fmax per clock);
+# the table goes to build/synth/resources.md and into docs/benchmarks.md's synth section.
+SYNTH_JOBS ?= 1
 synth: setup
-	$(PY) -m eyestereo.hdl.synth --out build/synth
+	$(PY) -m eyestereo.hdl.synth --out build/synth --doc docs/benchmarks.md --jobs $(SYNTH_JOBS)
+
+# WaveDrom diagrams (docs/wavedrom/*.json) -> docs/img/timing/*.svg and docs/timing.md, offline.
+timing: setup
+	$(PY) -m eyestereo.hdl.timing
+
+# Every reproducible table and figure of the thesis -> docs/thesis.md (+ docs/img/thesis/); runs make synth first.
+report: synth
+	$(PY) -m eyestereo.tools.reports.thesis --out docs/thesis.md --shared $(SHARED)
+
+# The report scripts take their inputs and outputs as arguments; real data beyond tests/data comes
+# from SHARED (a missing data set is left out of the report and said so).
+SHARED ?= ../shared/data
 
 bench: setup
 	$(PY) -m eyestereo.sim.benchmark --out docs/benchmarks.md
-	$(PY) -m eyestereo.tools.reports.harris_report --out docs/harris.md
-	$(PY) -m eyestereo.tools.reports.bench_ffc
-	$(PY) -m eyestereo.tools.reports.bench_matching --out docs/matching.md
+	$(PY) -m eyestereo.tools.reports.harris_report --out docs/harris.md \
+	  --image Tsukuba=tests/data/tsukuba_im3.png --image "chessboard left01=tests/data/chessboard_left01.jpg" \
+	  --image Venus=$(SHARED)/middlebury/venus/im2.png
+	$(PY) -m eyestereo.tools.reports.bench_ffc --out docs/ffc.md
+	$(PY) -m eyestereo.tools.reports.bench_matching --middlebury $(SHARED)/middlebury --out docs/matching.md \
+	  --img docs/img
+	$(PY) -m eyestereo.sim.bench_camera --out docs/camera.md
 	$(PY) -m eyestereo.sim.bench_sram --out docs/sram.md
 
 clean:

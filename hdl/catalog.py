@@ -12,6 +12,12 @@ from typing import Callable
 import numpy as np
 from myhdl import ResetSignal, Signal, intbv
 
+from eyestereo.hdl.async_fifo import async_fifo
+from eyestereo.hdl.camera_bus import CameraBus
+from eyestereo.hdl.camera_interface import camera_interface, camera_pair
+from eyestereo.hdl.camera_stream import camera_stream
+from eyestereo.hdl.axis import AxiStream
+from eyestereo.hdl.axis_to_stream import axis_to_stream
 from eyestereo.hdl.convolve import convolve
 from eyestereo.hdl.cornerness import cornerness
 from eyestereo.hdl.harris_mono import harris_mono
@@ -20,18 +26,22 @@ from eyestereo.hdl.nms import nms
 from eyestereo.hdl.prethreshold import prethreshold
 from eyestereo.hdl.line_delay import line_delay
 from eyestereo.hdl.sobel import sobel
+from eyestereo.hdl.stream_checker import stream_checker
+from eyestereo.hdl.queue import QueuePort
 from eyestereo.hdl.fetch_port import FetchPort
 from eyestereo.hdl.frame_buffers import BufferSide, FrameControl, double_buffer
-from eyestereo.hdl.queue_port import QueuePort
 from eyestereo.hdl.sram_arbiter import TAG_BITS, sram_arbiter
 from eyestereo.hdl.sram_bus import HostPort, SramCmd, SramPins, SramRsp, StatPort
 from eyestereo.hdl.sram_controller import sram_controller
 from eyestereo.hdl.sram_subsystem import sram_subsystem
 from eyestereo.hdl.stream import ImageStream
+from eyestereo.tools.camera import WORD as CAMERA_WORD
+from eyestereo.hdl.stream_to_axis import stream_to_axis
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import harris_window as window_model
 from eyestereo.tools.models import nms as nms_model
 from eyestereo.tools.models import sobel as sobel_model
+from eyestereo.tools.models import stream_checker as checker_model
 from eyestereo.tools.models.convolve import check_kernel, output_width
 
 
@@ -41,14 +51,19 @@ class BlockSpec:
     summary: str
     func: Callable
     defaults: dict
-    sink_width: Callable[[dict], int] | None = None
-    source_width: Callable[[dict], int] | None = None
+    sink_width: Callable[[dict], int]
+    source_width: Callable[[dict], int]
     hw_params: tuple[str, ...] = field(default=())  # parameters passed to the block function
     #: control ports after ``source``, in order: name -> function(params) -> fresh Signal
     control: tuple[tuple[str, Callable[[dict], object]], ...] = field(default=())
-    #: blocks whose ports are not ``clk, rst, sink, source, control...``: function(params) -> ordered dict
-    #: of every port (name -> fresh Signal or interface), passed to the block positionally in that order
-    ports: Callable[[dict], dict] | None = None
+    #: blocks whose ports are not ``clk, rst, sink, source, <control>`` (several clocks, a camera bus,
+    #: a queue port): function(params) -> (instance, ports dict) of a fresh instance
+    build: Callable[[dict], tuple[object, dict]] | None = None
+    #: interface classes of ``sink`` and ``source`` (built with the stream width)
+    sink_type: type = ImageStream
+    source_type: type = ImageStream
+    #: clock ports with the thesis's goal in MHz (None: none, or the default of eyestereo.hdl.synth)
+    clocks: tuple[tuple[str, float | None], ...] = (("clk", None),)
 
     def params(self, **overrides) -> dict:
         unknown = set(overrides) - set(self.defaults)
@@ -58,21 +73,33 @@ class BlockSpec:
         p.update(overrides)
         return p
 
-    def elaborate(self, **overrides):
-        """(instance, ports dict) of a fresh instance with the given parameters."""
+    def ports(self, **overrides) -> tuple[dict, dict, dict]:
+        """(fresh ports in call order, the block function's keyword parameters, all parameters).
+
+        A ``stereo`` parameter (blocks that take stereo streams have one) makes both streams stereo.
+        Blocks whose ports are not ``clk, rst, sink, source, <control>`` (several clocks, other
+        interfaces) make their ports with their ``build`` function.
+        """
         p = self.params(**overrides)
-        if self.ports is not None:
-            ports = self.ports(p)
-            kw = {k: v for k, v in p.items() if k in self.hw_params}
-            return self.func(*ports.values(), **kw), ports, p
-        clk = Signal(bool(0))
-        rst = ResetSignal(0, active=1, isasync=False)
-        sink = ImageStream(self.sink_width(p))
-        source = ImageStream(self.source_width(p))
         kw = {k: v for k, v in p.items() if k in self.hw_params}
-        ctrl = {name: make(p) for name, make in self.control}
-        inst = self.func(clk, rst, sink, source, *ctrl.values(), **kw)
-        return inst, dict(clk=clk, rst=rst, sink=sink, source=source, **ctrl), p
+        if self.build is not None:
+            return self.build(p), kw, p
+        stereo = bool(p.get("stereo", False))
+
+        def stream(kind, width):
+            return kind(width, stereo=stereo) if kind is ImageStream else kind(width)
+
+        ports = dict(clk=Signal(bool(0)), rst=ResetSignal(0, active=1, isasync=False),
+                     sink=stream(self.sink_type, self.sink_width(p)),
+                     source=stream(self.source_type, self.source_width(p)))
+        ports.update((name, make(p)) for name, make in self.control)
+        return ports, kw, p
+
+    def elaborate(self, **overrides):
+        """(instance, ports dict, parameters) of a fresh instance with the given parameters."""
+        ports, kw, p = self.ports(**overrides)
+        inst = self.func(*ports.values(), **kw)
+        return inst, ports, p
 
     def entity(self, **overrides) -> str:
         return self.name
@@ -96,10 +123,43 @@ def _conv_width(p):
     return output_width(k, p["data_width"], p["shift"])[0]
 
 
+def _rst():
+    return ResetSignal(0, active=1, isasync=False)
+
+
+_CAMERA = dict(width=352, height=288, order="YUYV", vsync_active=1, href_active=1)
+
+
+def _build_camera_stream(p):
+    ports = dict(cam=CameraBus(), rst=_rst(), source=ImageStream(CAMERA_WORD),
+                 luma=ImageStream(8) if p["luma"] else None)
+    return ports
+
+
+def _build_async_fifo(p):
+    ports = dict(wclk=Signal(bool(0)), wrst=_rst(), sink=ImageStream(p["data_width"]), rclk=Signal(bool(0)),
+                 rrst=_rst(), source=QueuePort(p["data_width"]), dropped=Signal(intbv(0)[16:]),
+                 full=Signal(bool(0)), empty=Signal(bool(0)))
+    return ports
+
+
+def _build_camera_interface(p):
+    ports = dict(cam=CameraBus(), wrst=_rst(), rclk=Signal(bool(0)), rrst=_rst(),
+                 source=QueuePort(CAMERA_WORD), dropped=Signal(intbv(0)[16:]))
+    return ports
+
+
+def _build_camera_pair(p):
+    ports = dict(cam_l=CameraBus(), wrst_l=_rst(), cam_r=CameraBus(), wrst_r=_rst(), rclk=Signal(bool(0)),
+                 rrst=_rst(), source_l=QueuePort(CAMERA_WORD), source_r=QueuePort(CAMERA_WORD),
+                 dropped_l=Signal(intbv(0)[16:]), dropped_r=Signal(intbv(0)[16:]))
+    return ports
+
+
 BLOCKS: dict[str, BlockSpec] = {
     "line_delay": BlockSpec(
         "line_delay", "one-line FIFO in block RAM: pixel (x, y-1) at (x, y)", line_delay,
-        dict(width=352, height=288, data_width=8),
+        dict(width=352, height=288, data_width=8, stereo=False),
         sink_width=lambda p: p["data_width"], source_width=lambda p: p["data_width"],
         hw_params=("width", "height")),
     "convolve": BlockSpec(
@@ -136,26 +196,60 @@ BLOCKS: dict[str, BlockSpec] = {
         sink_width=lambda p: 8, source_width=lambda p: nms_model.WORD.width,
         hw_params=("width", "height", "blocks", "nms"),
         control=(("k", _k_port),) + _thr_ports()),
+    "stream_checker": BlockSpec(
+        "stream_checker", "protocol checker: lines/frames of the wrong size, stereo interleaving; sticky error "
+        "and fault code; optional repair (broken frames become reset tokens)", stream_checker,
+        dict(width=352, height=288, data_width=8, stereo=False, repair=False),
+        sink_width=lambda p: p["data_width"], source_width=lambda p: p["data_width"],
+        hw_params=("width", "height", "repair"),
+        control=(("error", lambda p: Signal(bool(0))),
+                 ("code", lambda p: Signal(intbv(0)[checker_model.CODE_BITS:])))),
+    "camera_stream": BlockSpec(
+        "camera_stream", "camera bus (PCLK, VSYNC, HREF, 8-bit YUV 4:2:2) to 16-bit words, whole frames only",
+        camera_stream, dict(_CAMERA, luma=True), sink_width=lambda p: 8, source_width=lambda p: CAMERA_WORD.width,
+        hw_params=tuple(_CAMERA), build=_build_camera_stream, clocks=(("cam_pclk", 18.0),)),
+    "async_fifo": BlockSpec(
+        "async_fifo", "dual-clock frame FIFO: Gray pointers, a reset per domain, broken frames dropped and counted",
+        async_fifo, dict(data_width=CAMERA_WORD.width, depth=1024), sink_width=lambda p: p["data_width"],
+        source_width=lambda p: p["data_width"], hw_params=("depth",), build=_build_async_fifo,
+        clocks=(("wclk", 18.0), ("rclk", 100.0))),
+    "camera_interface": BlockSpec(
+        "camera_interface", "camera_stream + async_fifo: a camera bus in, whole frames in the system clock out",
+        camera_interface, dict(_CAMERA, depth=1024), sink_width=lambda p: 8,
+        source_width=lambda p: CAMERA_WORD.width, hw_params=(*_CAMERA, "depth"), build=_build_camera_interface,
+        clocks=(("cam_pclk", 18.0), ("rclk", 100.0))),
+    "camera_pair": BlockSpec(
+        "camera_pair", "two camera_interfaces, each with its own camera clock, into one system clock",
+        camera_pair, dict(_CAMERA, depth=1024), sink_width=lambda p: 8, source_width=lambda p: CAMERA_WORD.width,
+        hw_params=(*_CAMERA, "depth"), build=_build_camera_pair,
+        clocks=(("cam_l_pclk", 18.0), ("cam_r_pclk", 18.0), ("rclk", 100.0))),
+    "stream_to_axis": BlockSpec(
+        "stream_to_axis", "image stream -> AXI4-Stream video (UG934), FIFO for tready, cut frames on overflow",
+        stream_to_axis, dict(width=352, height=288, data_width=8, depth=1024, commit="line"),
+        sink_width=lambda p: p["data_width"], source_width=lambda p: p["data_width"],
+        hw_params=("width", "height", "depth", "commit"), source_type=AxiStream,
+        control=(("overflow", lambda p: Signal(bool(0))),)),
+    "axis_to_stream": BlockSpec(
+        "axis_to_stream", "AXI4-Stream video (UG934) -> image stream of a fixed geometry, tokens for faults",
+        axis_to_stream, dict(width=352, height=288, data_width=8),
+        sink_width=lambda p: p["data_width"], source_width=lambda p: p["data_width"],
+        hw_params=("width", "height"), sink_type=AxiStream,
+        control=(("error", lambda p: Signal(bool(0))),)),
 }
 
 
+# --- the SRAM subsystem (issue 12): blocks with interfaces of their own, ports made by ``build`` --------
 def _clk_rst():
-    return dict(clk=Signal(bool(0)), rst=ResetSignal(0, active=1, isasync=False))
+    return dict(clk=Signal(bool(0)), rst=_rst())
 
 
-def _sram_controller_ports(p):
+def _build_sram_controller(p):
     return dict(_clk_rst(), cmd=SramCmd(tag_bits=p["tag_bits"]), rsp=SramRsp(tag_bits=p["tag_bits"]),
                 sram=SramPins())
 
 
-BLOCKS["sram_controller"] = BlockSpec(
-    "sram_controller", "1M x 16 synchronous SRAM (NoBL or pipelined SyncBurst): pins <-> in-order word port",
-    sram_controller, dict(kind="nobl", read_latency=2, tag_bits=5),
-    hw_params=("kind", "read_latency"), ports=_sram_controller_ports)
-
-
 def _masters(p):
-    return dict(cam0=QueuePort(16), cam1=QueuePort(16), fetch=FetchPort(p["width"], p["height"]),
+    return dict(cam0=QueuePort(CAMERA_WORD), cam1=QueuePort(CAMERA_WORD), fetch=FetchPort(p["width"], p["height"]),
                 rect=ImageStream(8, stereo=True), feat=QueuePort(16), host=HostPort(), ctl=FrameControl(),
                 stat=StatPort())
 
@@ -163,19 +257,25 @@ def _masters(p):
 _ARB = dict(width=352, height=288, feature_words=8192, depth=16, burst=8, fetch_burst=8, host_burst=1,
             counter_bits=32)
 
-BLOCKS["sram_arbiter"] = BlockSpec(
-    "sram_arbiter", "six SRAM masters (2 cameras, fetch port, rectified, features, host), double buffers",
-    sram_arbiter, dict(_ARB), hw_params=tuple(_ARB),
-    ports=lambda p: dict(_clk_rst(), **_masters(p), cmd=SramCmd(tag_bits=TAG_BITS), rsp=SramRsp(tag_bits=TAG_BITS)))
-
-BLOCKS["sram_subsystem"] = BlockSpec(
-    "sram_subsystem", "sram_arbiter + sram_controller: the SRAM's pins and the six masters' ports",
-    sram_subsystem, dict(_ARB, kind="nobl", read_latency=2), hw_params=tuple(_ARB) + ("kind", "read_latency"),
-    ports=lambda p: dict(_clk_rst(), **_masters(p), sram=SramPins()))
-
+BLOCKS["sram_controller"] = BlockSpec(
+    "sram_controller", "1M x 16 synchronous SRAM (NoBL or pipelined SyncBurst): pins <-> in-order word port",
+    sram_controller, dict(kind="nobl", read_latency=2, tag_bits=5), sink_width=lambda p: 16,
+    source_width=lambda p: 16, hw_params=("kind", "read_latency"), build=_build_sram_controller,
+    clocks=(("clk", 100.0),))
 BLOCKS["double_buffer"] = BlockSpec(
     "double_buffer", "frame handshake of one producer's two SRAM buffers (FREE/WRITING/FULL/READING)",
-    double_buffer, dict(), ports=lambda p: dict(_clk_rst(), side=BufferSide()))
+    double_buffer, dict(), sink_width=lambda p: 1, source_width=lambda p: 1,
+    build=lambda p: dict(_clk_rst(), side=BufferSide()), clocks=(("clk", 100.0),))
+BLOCKS["sram_arbiter"] = BlockSpec(
+    "sram_arbiter", "six SRAM masters (2 cameras, fetch port, rectified, features, host), double buffers",
+    sram_arbiter, dict(_ARB), sink_width=lambda p: 16, source_width=lambda p: 8, hw_params=tuple(_ARB),
+    build=lambda p: dict(_clk_rst(), **_masters(p), cmd=SramCmd(tag_bits=TAG_BITS), rsp=SramRsp(tag_bits=TAG_BITS)),
+    clocks=(("clk", 100.0),))
+BLOCKS["sram_subsystem"] = BlockSpec(
+    "sram_subsystem", "sram_arbiter + sram_controller: the SRAM's pins and the six masters' ports",
+    sram_subsystem, dict(_ARB, kind="nobl", read_latency=2), sink_width=lambda p: 16, source_width=lambda p: 8,
+    hw_params=tuple(_ARB) + ("kind", "read_latency"), build=lambda p: dict(_clk_rst(), **_masters(p), sram=SramPins()),
+    clocks=(("clk", 100.0),))
 
 
 def get(name: str) -> BlockSpec:

@@ -24,8 +24,29 @@ GHDL_STDS = ("93c", "08")
 _PORT = re.compile(r"^\s*(\w+)\s*:\s*(in|out|inout)\s+([^;]+?);?\s*$", re.M)
 
 
+# MyHDL writes initial values as VHDL-2008 sized bit strings (``12X"0"``), which VHDL-93 rejects.
+_SIZED_LITERAL = re.compile(r'\b(\d+)X"([0-9A-Fa-f]+)"')
+
+
+def _plain_literal(m: re.Match) -> str:
+    n, value = int(m.group(1)), int(m.group(2), 16)
+    if value >> n:
+        raise ValueError(f"initial value {m.group(0)} does not fit {n} bits")
+    return '"' + format(value, f"0{n}b") + '"'
+
+
+def vhdl93_literals(text: str) -> str:
+    """``N X"hex"`` literals rewritten as N-character bit strings (valid in VHDL-93 and VHDL-2008)."""
+    return _SIZED_LITERAL.sub(_plain_literal, text)
+
+
 def convert(name: str, path: Path, *, hdl: str = "VHDL", entity: str | None = None, **params) -> list[Path]:
-    """Convert one block (fresh instance) into ``path``; returns the files written (package first)."""
+    """Convert one block (fresh instance) into ``path``; returns the files written (package first).
+
+    Every signal and memory gets its initial value (``initial_values=True``): a simulation starts
+    from the state a real FPGA starts from (flip-flops and block RAM at 0 after configuration), so no
+    output is ever undefined, and synthesis keeps the values as the registers' and RAMs' INIT.
+    """
     spec = get(name)
     path = Path(path)
     path.mkdir(parents=True, exist_ok=True)
@@ -34,9 +55,11 @@ def convert(name: str, path: Path, *, hdl: str = "VHDL", entity: str | None = No
     with warnings.catch_warnings():
         # Unread outputs of shared sub-blocks (e.g. a line delay's flags) are expected; keep logs readable.
         warnings.simplefilter("ignore")
-        inst.convert(hdl=hdl, name=entity, path=str(path), initial_values=False)
+        inst.convert(hdl=hdl, name=entity, path=str(path), initial_values=True)
     if hdl == "VHDL":
-        return sorted(path.glob("pck_myhdl_*.vhd")) + [path / f"{entity}.vhd"]
+        vhd = path / f"{entity}.vhd"
+        vhd.write_text(vhdl93_literals(vhd.read_text()))
+        return sorted(path.glob("pck_myhdl_*.vhd")) + [vhd]
     return [path / f"{entity}.v"]
 
 
@@ -61,7 +84,10 @@ def analyse(files: list[Path], std: str, workdir: Path) -> None:
 
 
 def make_vhdl(out: Path) -> dict:
-    """Write the default configuration of every block to ``out`` with its manifest, then analyse it."""
+    """Write the default configuration of every block to ``out`` with its manifest, then analyse it.
+
+    Also writes a FuseSoC core per block (:mod:`eyestereo.hdl.fusesoc`).
+    """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     manifest = {"blocks": [], "package": None, "ghdl_std": list(GHDL_STDS)}
@@ -81,6 +107,9 @@ def make_vhdl(out: Path) -> dict:
     for std in GHDL_STDS:
         with tempfile.TemporaryDirectory() as tmp:
             analyse([out / manifest["package"]] + files, std, Path(tmp))
+    from eyestereo.hdl.fusesoc import write_cores
+
+    manifest["cores"] = [p.name for p in write_cores(out, manifest)]
     (out / "manifest.json").write_text(json.dumps(manifest, indent=2) + "\n")
     return manifest
 
@@ -95,7 +124,7 @@ def main(argv=None) -> int:
         print(f"make vhdl: {e}", file=sys.stderr)
         return 1
     for b in m["blocks"]:
-        print(f"{args.out}/{b['entity']}.vhd  ({len(b['ports'])} ports)")
+        print(f"{args.out}/{b['entity']}.vhd  ({len(b['ports'])} ports)  {b['entity']}.core")
     print(f"analysed with GHDL --std={' and --std='.join(GHDL_STDS)}: OK")
     return 0
 

@@ -5,8 +5,9 @@ from myhdl import Signal, always, always_comb, block, intbv
 
 from eyestereo.hdl.common import range_signal, signal_range, column_taps, delay, en_reg, shift_add, window_control
 from eyestereo.hdl.common.fixed import fx_signal
+from eyestereo.hdl.common.checks import (block_error, check_clock, check_distinct, check_frame, check_int,
+                                         check_reset, check_stream, checked)
 from eyestereo.tools.models.convolve import check_kernel, output_format
-from eyestereo.tools.stream import check_geometry
 
 
 @block
@@ -22,7 +23,8 @@ def convolve(clk, rst, sink, source, *, kernel=None, col=None, row=None, shift: 
 
     Ports:
         clk, rst: clock and synchronous active-high reset (control only).
-        sink: ImageStream, unsigned pixels of any width up to 36 bits.
+        sink: ImageStream, unsigned pixels of any width up to 36 bits; mono only (a stereo stream
+            is refused).
         source: ImageStream whose data width is :func:`eyestereo.tools.models.convolve.output_width`
             (two's complement when the kernel has negative coefficients).
 
@@ -36,18 +38,23 @@ def convolve(clk, rst, sink, source, *, kernel=None, col=None, row=None, shift: 
     Resources: N - 1 line delays (one RAMB16 each for width x data bits up to 512x36), adders and
     registers; no multipliers.
     """
-    k, separable = check_kernel(kernel, col, row)
+    check_clock(clk)
+    check_reset(rst)
+    check_stream("sink", sink)
+    check_stream("source", source)
+    check_distinct(dict(source=source), dict(clk=clk, rst=rst, sink=sink))
+    dw = sink.data_width
+    if dw > 36:
+        raise block_error(f"port sink data is {dw} bits wide, at most 36 fit the line delays' block RAM words")
+    k, separable = checked(check_kernel, kernel, col, row)
     n = k.shape[0]
     r = n // 2
-    check_geometry(width, height, min_size=n)
-    if isinstance(shift, bool) or not isinstance(shift, (int, np.integer)) or shift < 0:
-        raise ValueError(f"shift must be an int >= 0, got {shift!r}")
-    dw = len(sink.data)
-    shift = int(shift)
+    width, height = check_frame(width, height, min_size=n)
+    shift = check_int("shift", shift, 0)
     fmt = output_format(k, dw, shift)
     bits = fmt.wl
-    if len(source.data) != bits:
-        raise ValueError(f"convolve source needs {bits} data bits for this kernel and shift, has {len(source.data)}")
+    if source.data_width != bits:
+        raise block_error(f"port source needs {bits} data bits for this kernel and shift, has {source.data_width}")
 
     taps = [Signal(intbv(0)[dw:]) for _ in range(n)]
     tap_valid = Signal(bool(0))

@@ -7,7 +7,8 @@ from eyestereo.hdl.common import delay_rst
 from eyestereo.hdl.common.packed import unpack_word
 from eyestereo.tools.models import cornerness as model
 from eyestereo.tools.models import harris_window as window_model
-from eyestereo.tools.stream import check_geometry
+from eyestereo.hdl.common.checks import (check_clock, check_distinct, check_frame, check_reset, check_signal,
+                                         check_stream)
 
 LATENCY = model.LATENCY
 
@@ -24,10 +25,11 @@ def cornerness(clk, rst, sink, source, k, *, width: int = 352, height: int = 288
 
     Ports:
         clk, rst: clock and synchronous active-high reset (control only).
-        sink: ImageStream, 57 bits from ``harris_window`` (Sxy | Syy | Sxx).
+        sink: ImageStream, 57 bits from ``harris_window`` (Sxy | Syy | Sxx); mono only (a stereo
+            stream is refused).
         source: ImageStream, 20 bits: the cornerness, two's complement (units:
             :func:`eyestereo.tools.models.harris_mono.harris_float` / 2**21).
-        k: input, 8 bits, ufix[8,8]: k = code / 256 (:func:`eyestereo.tools.models.harris_mono.k_code`);
+        k: input, 8 bits unsigned, ufix[8,8]: k = code / 256 (:func:`eyestereo.tools.models.harris_mono.k_code`);
             sampled every clock, change it between frames.
 
     Parameters:
@@ -37,13 +39,13 @@ def cornerness(clk, rst, sink, source, k, *, width: int = 352, height: int = 288
 
     Resources: 4 MULT18X18, adders and pipeline registers, no block RAM.
     """
-    check_geometry(width, height)
-    if len(sink.data) != window_model.OUT_BITS:
-        raise ValueError(f"cornerness takes {window_model.OUT_BITS}-bit window words, sink has {len(sink.data)}")
-    if len(source.data) != model.OUT.wl:
-        raise ValueError(f"cornerness source carries {model.OUT.wl} bits, has {len(source.data)}")
-    if len(k) != model.K.wl:
-        raise ValueError(f"k port must be {model.K.wl} bits (ufix[8,8]), got {len(k)}")
+    check_clock(clk)
+    check_reset(rst)
+    check_stream("sink", sink, width=window_model.OUT_BITS)
+    check_stream("source", source, width=model.OUT.wl)
+    check_signal("k", k, width=model.K.wl, signed=False)
+    check_distinct(dict(source=source), dict(clk=clk, rst=rst, sink=sink, k=k))
+    width, height = check_frame(width, height)
 
     S = model.STAGES
     sxx, syy = fx_signal(window_model.SUM_SQ), fx_signal(window_model.SUM_SQ)

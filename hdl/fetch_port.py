@@ -49,7 +49,9 @@ import numbers
 
 from myhdl import Signal, intbv
 
-__all__ = ["FetchPort", "MASK_BITS", "OFFSETS"]
+from eyestereo.hdl.common.checks import block_error
+
+__all__ = ["FetchPort", "MASK_BITS", "OFFSETS", "check_fetch"]
 
 MASK_BITS = 4
 #: (dx, dy) of index i of the 2x2 neighbourhood.
@@ -80,3 +82,11 @@ class FetchPort:
 
     def __repr__(self) -> str:
         return f"FetchPort(width={self.width}, height={self.height})"
+
+
+def check_fetch(name: str, port) -> None:
+    """A :class:`FetchPort` port, else a ValueError naming the port and the block."""
+    if not isinstance(port, FetchPort):
+        got = "None" if port is None else (f"{type(port).__name__} {port!r}"[:60] if isinstance(port, (int, str))
+                                           else type(port).__name__)
+        raise block_error(f"port {name} must be a FetchPort (req_*, rsp_*), got {got}")

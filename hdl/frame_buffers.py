@@ -36,7 +36,7 @@ from __future__ import annotations
 
 from myhdl import Signal, always_comb, always_seq, block, concat, intbv
 
-from eyestereo.hdl.common.checks import check_clock, check_reset
+from eyestereo.hdl.common.checks import block_error, check_clock, check_reset
 
 __all__ = ["FrameControl", "double_buffer", "FREE", "WRITING", "FULL", "READING"]
 
@@ -135,6 +135,8 @@ def double_buffer(clk, rst, side: BufferSide):
     """
     check_clock(clk)
     check_reset(rst)
+    if not isinstance(side, BufferSide):
+        raise block_error(f"port side must be a BufferSide, got {'None' if side is None else type(side).__name__}")
     s0 = Signal(intbv(FREE)[2:])
     s1 = Signal(intbv(FREE)[2:])
     newest = Signal(bool(0))

@@ -15,7 +15,9 @@ from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import harris_window as window_model
 from eyestereo.tools.models import sobel as sobel_model
 from eyestereo.tools.models.harris_mono import check_params, k_code, radius, threshold_code  # noqa: F401 (re-export)
-from eyestereo.tools.stream import check_geometry
+from eyestereo.tools.models.prethreshold import check_blocks
+from eyestereo.hdl.common.checks import (block_error, check_choice, check_clock, check_distinct, check_frame,
+                                         check_reset, check_signal, check_stream, checked)
 
 
 def latency(nms: int) -> tuple[int, int]:
@@ -36,9 +38,9 @@ def harris_mono(clk, rst, sink, source, k, thr_we, thr_addr, thr_data, *, width:
 
     Ports:
         clk, rst: clock and synchronous active-high reset.
-        sink: ImageStream, 8-bit grey pixels.
+        sink: ImageStream, 8-bit grey pixels; mono only (a stereo stream is refused).
         source: ImageStream, 1 bit: the feature flag.
-        k: input, 8 bits, ufix[8,8] (k = code / 256); ``k_code(0.04)`` gives the code.
+        k: input, 8 bits unsigned, ufix[8,8] (k = code / 256); ``k_code(0.04)`` gives the code.
         thr_we, thr_addr, thr_data: the pre-threshold's register port (block index by*BX + bx, 20-bit
             threshold code; ``threshold_code(c)`` converts a threshold in harris_float units). All
             thresholds are 0 after ``rst``.
@@ -53,12 +55,24 @@ def harris_mono(clk, rst, sink, source, k, thr_we, thr_addr, thr_data, *, width:
 
     Resources: 6 (nms 1) to 10 (nms 5) RAMB16, 7 multipliers (3 window, 4 cornerness); see docs/benchmarks.md.
     """
-    check_geometry(width, height, min_size=5)
-    check_params(width, height, blocks, nms)
-    if len(sink.data) != 8:
-        raise ValueError(f"harris_mono takes 8-bit pixels, sink has {len(sink.data)} bits")
-    if len(source.data) != 1:
-        raise ValueError(f"harris_mono source carries a 1-bit flag, has {len(source.data)} bits")
+    # Every port and parameter is checked here, so no error comes from inside one of the five blocks.
+    nb = corner_model.OUT.wl
+    check_clock(clk)
+    check_reset(rst)
+    check_stream("sink", sink, width=8)
+    check_stream("source", source, width=1)
+    check_signal("k", k, width=corner_model.K.wl, signed=False)
+    check_signal("thr_we", thr_we, width=1)
+    check_signal("thr_addr", thr_addr, signed=False)
+    check_signal("thr_data", thr_data, width=nb, signed=False)
+    check_distinct(dict(source=source), dict(clk=clk, rst=rst, sink=sink, k=k, thr_we=thr_we, thr_addr=thr_addr,
+                                             thr_data=thr_data))
+    width, height = check_frame(width, height, min_size=5)
+    nms = check_choice("nms", nms, (1, 3, 5))
+    blocks = checked(check_blocks, width, height, blocks)
+    abits = max(1, (blocks[0] * blocks[1] - 1).bit_length())
+    if len(thr_addr) < abits:
+        raise block_error(f"port thr_addr needs {abits} bits for {blocks[0] * blocks[1]} blocks, has {len(thr_addr)}")
     s_sobel = ImageStream(sobel_model.WORD)
     s_window = ImageStream(window_model.WORD)
     s_corner = ImageStream(corner_model.WORD)

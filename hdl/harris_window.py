@@ -9,7 +9,7 @@ from eyestereo.hdl.common.packed import pack_word, unpack_word
 from eyestereo.tools.models import sobel as sobel_model
 from eyestereo.tools.models import harris_window as model
 from eyestereo.tools.fixed import sfix
-from eyestereo.tools.stream import check_geometry
+from eyestereo.hdl.common.checks import check_clock, check_distinct, check_frame, check_reset, check_stream
 
 N = 5
 LATENCY = 8  # 1 product stage + the window's N + 2
@@ -29,7 +29,8 @@ def harris_window(clk, rst, sink, source, *, width: int = 352, height: int = 288
 
     Ports:
         clk, rst: clock and synchronous active-high reset (control only).
-        sink: ImageStream, 18 bits: Iy in bits 17..9, Ix in 8..0 (sfix[9,-3] codes, as from ``sobel``).
+        sink: ImageStream, 18 bits: Iy in bits 17..9, Ix in 8..0 (sfix[9,-3] codes, as from ``sobel``);
+            mono only (a stereo stream is refused).
         source: ImageStream, 57 bits: Sxy in 56..38 (two's complement), Syy in 37..19, Sxx in 18..0.
 
     Parameters:
@@ -39,12 +40,12 @@ def harris_window(clk, rst, sink, source, *, width: int = 352, height: int = 288
 
     Resources: 3 multipliers (10x10), 4 line delays of 36 bits (4 RAMB16), adders and registers.
     """
-    check_geometry(width, height, min_size=N)
-    if len(sink.data) != sobel_model.WORD.width:
-        raise ValueError(f"harris_window takes {sobel_model.WORD.width}-bit Sobel words (Iy, Ix), "
-                         f"sink has {len(sink.data)} bits")
-    if len(source.data) != model.OUT_BITS:
-        raise ValueError(f"harris_window source carries {model.OUT_BITS} bits, has {len(source.data)}")
+    check_clock(clk)
+    check_reset(rst)
+    check_stream("sink", sink, width=sobel_model.WORD.width)
+    check_stream("source", source, width=model.OUT_BITS)
+    check_distinct(dict(source=source), dict(clk=clk, rst=rst, sink=sink))
+    width, height = check_frame(width, height, min_size=N)
 
     mx = fx_signal(sfix(10))  # 2 Ix + 1
     my = fx_signal(sfix(10))

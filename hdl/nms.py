@@ -5,7 +5,8 @@ from myhdl import Signal, always, always_comb, always_seq, block, intbv
 from eyestereo.hdl.common.fixed import fx_signal
 from eyestereo.hdl.common import assign, column_taps, delay, en_reg, window_control
 from eyestereo.tools.models import cornerness as corner_model
-from eyestereo.tools.stream import check_geometry
+from eyestereo.hdl.common.checks import (check_choice, check_clock, check_distinct, check_frame, check_reset,
+                                         check_stream)
 
 SIZES = (1, 3, 5)
 
@@ -24,7 +25,8 @@ def nms(clk, rst, sink, source, *, width: int = 352, height: int = 288, size: in
 
     Ports:
         clk, rst: clock and synchronous active-high reset (control only).
-        sink: ImageStream, 20 bits, two's complement (the pre-thresholded cornerness).
+        sink: ImageStream, 20 bits, two's complement (the pre-thresholded cornerness); mono only (a
+            stereo stream is refused).
         source: ImageStream, 1 bit: the feature flag.
 
     Parameters:
@@ -35,14 +37,14 @@ def nms(clk, rst, sink, source, *, width: int = 352, height: int = 288, size: in
 
     Resources: N - 1 line delays of 20 bits (one RAMB16 each), 3N registers of 20 bits, 3N - 1 comparators.
     """
-    if size not in SIZES:
-        raise ValueError(f"nms size must be one of {SIZES}, got {size!r}")
-    check_geometry(width, height, min_size=size)
     nb = corner_model.OUT.wl
-    if len(sink.data) != nb:
-        raise ValueError(f"nms sink must be {nb} bits (the cornerness format), has {len(sink.data)}")
-    if len(source.data) != 1:
-        raise ValueError(f"nms source carries a 1-bit flag, has {len(source.data)} bits")
+    check_clock(clk)
+    check_reset(rst)
+    check_stream("sink", sink, width=nb)
+    check_stream("source", source, width=1)
+    check_distinct(dict(source=source), dict(clk=clk, rst=rst, sink=sink))
+    size = check_choice("size", size, SIZES)
+    width, height = check_frame(width, height, min_size=size)
 
     if size == 1:
         v = fx_signal(corner_model.OUT)

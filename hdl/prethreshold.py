@@ -5,7 +5,8 @@ from myhdl import Signal, always, always_comb, always_seq, block, intbv
 from eyestereo.hdl.common.fixed import fx_signal
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models.prethreshold import block_edges, check_blocks
-from eyestereo.tools.stream import check_geometry
+from eyestereo.hdl.common.checks import (block_error, check_clock, check_distinct, check_frame, check_reset,
+                                         check_signal, check_stream, checked)
 
 
 @block
@@ -20,11 +21,13 @@ def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: i
 
     Ports:
         clk, rst: clock and synchronous active-high reset.
-        sink: ImageStream, 20 bits, cornerness (two's complement), e.g. from ``cornerness``.
+        sink: ImageStream, 20 bits, cornerness (two's complement), e.g. from ``cornerness``; mono only
+            (a stereo stream is refused).
         source: ImageStream, 20 bits, same format.
         thr_we: input, write enable of the threshold register port.
-        thr_addr: input, block index by*BX + bx (writes to indices >= BX*BY are ignored).
-        thr_data: input, 20 bits, the threshold in the cornerness format (signed).
+        thr_addr: input, unsigned, at least log2(BX*BY) bits (1 for one block): block index by*BX + bx
+            (writes to indices >= BX*BY are ignored).
+        thr_data: input, 20 bits unsigned: the threshold's two's complement code (cornerness format).
 
     Parameters:
         width, height: frame size, 1..4096.
@@ -34,17 +37,23 @@ def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: i
 
     Resources: BX*BY x 20 bits of LUT-RAM, BX*BY flag registers, position counters, one comparator.
     """
-    check_geometry(width, height)
-    check_blocks(width, height, blocks)
-    bxn, byn = blocks
     nb = corner_model.OUT.wl
-    for name, sig in (("sink", sink.data), ("source", source.data), ("thr_data", thr_data)):
-        if len(sig) != nb:
-            raise ValueError(f"prethreshold {name} must be {nb} bits (the cornerness format), has {len(sig)}")
+    check_clock(clk)
+    check_reset(rst)
+    check_stream("sink", sink, width=nb)
+    check_stream("source", source, width=nb)
+    check_signal("thr_we", thr_we, width=1)
+    check_signal("thr_addr", thr_addr, signed=False)
+    check_signal("thr_data", thr_data, width=nb, signed=False)
+    check_distinct(dict(source=source), dict(clk=clk, rst=rst, sink=sink, thr_we=thr_we, thr_addr=thr_addr,
+                                             thr_data=thr_data))
+    width, height = check_frame(width, height)
+    blocks = checked(check_blocks, width, height, blocks)
+    bxn, byn = blocks
     nblk = bxn * byn
     abits = max(1, (nblk - 1).bit_length())
     if len(thr_addr) < abits:
-        raise ValueError(f"thr_addr needs {abits} bits for {nblk} blocks, has {len(thr_addr)}")
+        raise block_error(f"port thr_addr needs {abits} bits for {nblk} blocks, has {len(thr_addr)}")
 
     if nblk == 1:
         return global_threshold(clk, rst, sink, source, thr_we, thr_data)
@@ -66,14 +75,27 @@ def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: i
     xl = Signal(intbv(0, min=0, max=width))
     yl = Signal(intbv(0, min=0, max=height))
 
+    # A write to an index past the last block is ignored. When every address names a block the check
+    # is left out: GHDL 2.0's synthesis truncates the constant of "thr_addr < 16" to 4 bits (0), and
+    # the netlist make synth measures would then never write a threshold.
+    we = Signal(bool(0))
+    if nblk >= (1 << len(thr_addr)):
+        @always_comb
+        def write_check():
+            we.next = thr_we
+    else:
+        @always_comb
+        def write_check():
+            we.next = thr_we and thr_addr < nblk
+
     @always(clk.posedge)
     def ram():
-        if thr_we and thr_addr < nblk:
+        if we:
             mem[thr_addr].next = thr_data
 
     @always_seq(clk.posedge, reset=rst)
     def flags():
-        if thr_we and thr_addr < nblk:
+        if we:
             written.next[thr_addr] = 1
 
     @always_comb
@@ -121,7 +143,7 @@ def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: i
                 if x == xl:
                     bx.next = bx + 1
 
-    return ram, flags, lookup, read, choose, position, pass_greater(clk, rst, sink, source, value, thr)
+    return write_check, ram, flags, lookup, read, choose, position, pass_greater(clk, rst, sink, source, value, thr)
 
 
 @block

@@ -7,7 +7,7 @@ from eyestereo.hdl.common import range_signal, column_taps, delay, en_reg, shift
 from eyestereo.tools.fixed import shift_between
 from eyestereo.hdl.common.packed import pack_word
 from eyestereo.tools.models.sobel import GRAD, OUT, WORD
-from eyestereo.tools.stream import check_geometry
+from eyestereo.hdl.common.checks import check_clock, check_distinct, check_frame, check_reset, check_stream
 
 LATENCY = 5
 
@@ -25,7 +25,7 @@ def sobel(clk, rst, sink, source, *, width: int = 352, height: int = 288):
 
     Ports:
         clk, rst: clock and synchronous active-high reset (control only).
-        sink: ImageStream, 8-bit grey pixels.
+        sink: ImageStream, 8-bit grey pixels; mono only (a stereo stream is refused).
         source: ImageStream, 18 bits: Iy in bits 17..9, Ix in bits 8..0, two's complement.
 
     Parameters:
@@ -35,11 +35,12 @@ def sobel(clk, rst, sink, source, *, width: int = 352, height: int = 288):
 
     Resources: 2 line delays (2 RAMB16 for width <= 2048), shift-and-add logic, no multipliers.
     """
-    check_geometry(width, height, min_size=3)
-    if len(sink.data) != 8:
-        raise ValueError(f"sobel takes 8-bit pixels, sink has {len(sink.data)} data bits")
-    if len(source.data) != WORD.width:
-        raise ValueError(f"sobel source carries {WORD.width} bits (Iy, Ix), has {len(source.data)}")
+    check_clock(clk)
+    check_reset(rst)
+    check_stream("sink", sink, width=8)
+    check_stream("source", source, width=WORD.width)
+    check_distinct(dict(source=source), dict(clk=clk, rst=rst, sink=sink))
+    width, height = check_frame(width, height, min_size=3)
 
     top, mid, bot = taps = [Signal(intbv(0)[8:]) for _ in range(3)]
     tap_valid = Signal(bool(0))

@@ -2,11 +2,12 @@
 
 from myhdl import ConcatSignal, Signal, always, always_comb, always_seq, block, concat, intbv
 
-from eyestereo.hdl.common.checks import check_clock, check_int, check_reset, check_stream
-from eyestereo.hdl.fetch_port import FetchPort
+from eyestereo.hdl.common.checks import (block_error, check_choice, check_clock, check_distinct, check_frame,
+                                         check_int, check_reset, check_stream)
+from eyestereo.hdl.fetch_port import check_fetch
 from eyestereo.hdl.frame_buffers import BufferSide, FrameControl, double_buffer
-from eyestereo.hdl.queue_port import QueuePort
-from eyestereo.hdl.sram_bus import HostPort, SramCmd, SramRsp, StatPort
+from eyestereo.hdl.queue import check_queue
+from eyestereo.hdl.sram_bus import HostPort, SramCmd, SramRsp, StatPort, check_bundle
 from eyestereo.hdl.sram_masters import (ENTRY_BITS, Head, camera_in, feature_in, fetch_slave, frame_writer, host_slave,
                                         rect_in)
 from eyestereo.tools.models.sram_arbiter import MASTERS, AddressMap
@@ -16,9 +17,38 @@ CAM0, CAM1, FETCH, RECT, FEAT, HOST = range(NM)
 TAG_BITS = 3  # tag of a read: host << 2 | fetch index
 
 
-def _check_port(name, port, cls):
-    if not isinstance(port, cls):
-        raise ValueError(f"port {name} must be a {cls.__name__}, got {type(port).__name__}")
+def check_masters(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, *, width, height, feature_words, depth,
+                  burst, fetch_burst, host_burst, counter_bits) -> tuple:
+    """The masters' ports and the arbiter's parameters (shared by :func:`sram_arbiter` and the subsystem,
+    so that the block a user instantiates names itself in the message); returns the parameters as ints
+    and the address map."""
+    check_clock(clk)
+    check_reset(rst)
+    for name, port in (("cam0", cam0), ("cam1", cam1), ("feat", feat)):
+        check_queue(name, port, width=16)
+    check_fetch("fetch", fetch)
+    check_stream("rect", rect, width=8, stereo=True)
+    check_bundle("host", host, HostPort)
+    check_bundle("ctl", ctl, FrameControl)
+    check_bundle("stat", stat, StatPort)
+    width, height = check_frame(width, height, min_size=2)
+    feature_words = check_int("feature_words", feature_words, 2, 65536)
+    depth = check_choice("depth", depth, (8, 16, 32))
+    burst = check_int("burst", burst, 2, depth // 2)
+    fetch_burst = check_int("fetch_burst", fetch_burst, 4, 16)
+    host_burst = check_int("host_burst", host_burst, 1, 8)
+    counter_bits = check_int("counter_bits", counter_bits, 16, 32)
+    if (fetch.width, fetch.height) != (width, height):
+        raise block_error(f"port fetch is for {fetch.width}x{fetch.height} frames, the frame buffers for "
+                          f"{width}x{height}")
+    if len(stat.addr) < 5 or len(stat.data) != 32:
+        raise block_error(f"port stat needs at least 5 address bits and 32 data bits, got {len(stat.addr)} and "
+                          f"{len(stat.data)}")
+    try:
+        amap = AddressMap(width, height, feature_words)
+    except ValueError as e:
+        raise block_error(f"parameters width, height, feature_words: {e}") from None
+    return width, height, feature_words, depth, burst, fetch_burst, host_burst, counter_bits, amap
 
 
 @block
@@ -48,15 +78,17 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
 
     Arbitration, one access per clock: the master owning the bus issues one access per clock while it
     has one, for up to its burst length (writers: ``burst``; fetch: ``fetch_burst`` reads, i.e. whole
-    requests; host: ``host_burst``). The next owner is chosen a clock ahead, round robin from the one
-    after the current owner, among the *urgent* masters if any, else among all that ask for a turn.
-    Writers ask when ``burst`` words or a frame's end wait in their FIFO; camera writers are then always
-    urgent, the rectified writer when its FIFO is 3/4 full; an urgent master ends a non-urgent turn at
-    the next clock. So a camera waits at most for the other camera's burst and the bus turnaround,
-    whatever the rest does, and every master is served within one round: no starvation. On a pipelined
-    SyncBurst part the controller holds a write back during the turnaround; the turn is kept meanwhile,
-    so a stream of reads cannot starve a write. The owner, the next owner and the command to the
-    controller are registers: between flip-flops there are at most a few LUT levels (docs/sram.md).
+    requests; host: ``host_burst``). Writers ask for a turn when ``burst`` words or a frame's end wait in
+    their FIFO. The writers of the streams that cannot wait (both cameras and the rectified stream) are
+    then *urgent*; the feature writer (its queue port can wait), the fetch port and the host are not.
+    The next owner is chosen a clock ahead: round robin among the urgent masters if any asks, else round
+    robin among the others, each round robin keeping its own place. An urgent master ends a non-urgent
+    turn at the next clock once that turn has moved a word. So an urgent writer waits at most for one
+    access, the other urgent writers' bursts and a bus turnaround, whatever the rest does, and every turn
+    moves at least one word: no master starves (docs/sram.md measures the waits under overload). On a
+    pipelined SyncBurst part the controller holds a write back during the turnaround; the turn is kept
+    meanwhile, so a stream of reads cannot starve a write. The owner, the next owner and the command to
+    the controller are registers: between flip-flops there are at most a few LUT levels.
 
     Frame buffers (hdl/frame_buffers.py): each writer has two buffers (address map:
     :class:`eyestereo.tools.models.sram_arbiter.AddressMap`) and a :func:`double_buffer` state; the system's
@@ -70,7 +102,7 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
 
     Ports:
         clk, rst: clock (the SRAM's, 100 MHz) and synchronous active-high reset.
-        cam0, cam1: :class:`~eyestereo.hdl.queue_port.QueuePort`, 16 bits.
+        cam0, cam1: :class:`~eyestereo.hdl.queue.QueuePort`, 16 bits.
         fetch: :class:`~eyestereo.hdl.fetch_port.FetchPort` for ``width`` x ``height``.
         rect: :class:`~eyestereo.hdl.stream.ImageStream`, 8 bits, stereo.
         feat: QueuePort, 16 bits.
@@ -93,36 +125,16 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
 
     Resources: see docs/sram.md (Yosys, Spartan-3E).
     """
-    check_clock(clk)
-    check_reset(rst)
-    for name, port, cls in (("cam0", cam0, QueuePort), ("cam1", cam1, QueuePort), ("fetch", fetch, FetchPort),
-                            ("feat", feat, QueuePort), ("host", host, HostPort), ("ctl", ctl, FrameControl),
-                            ("stat", stat, StatPort), ("cmd", cmd, SramCmd), ("rsp", rsp, SramRsp)):
-        _check_port(name, port, cls)
-    check_stream("rect", rect, width=8, stereo=True)
-    for name, port in (("cam0", cam0), ("cam1", cam1), ("feat", feat)):
-        if port.data_width != 16:
-            raise ValueError(f"port {name} must carry 16-bit words, got {port.data_width}")
-    width = check_int("width", width, 2, 4096)
-    height = check_int("height", height, 2, 4096)
-    feature_words = check_int("feature_words", feature_words, 2, 65536)
-    depth = check_int("depth", depth, 8, 32)
-    if depth & (depth - 1):
-        raise ValueError(f"parameter depth={depth} must be a power of two (8, 16, 32)")
-    burst = check_int("burst", burst, 2, depth // 2)
-    fetch_burst = check_int("fetch_burst", fetch_burst, 4, 16)
-    host_burst = check_int("host_burst", host_burst, 1, 8)
-    counter_bits = check_int("counter_bits", counter_bits, 16, 32)
-    if (fetch.width, fetch.height) != (width, height):
-        raise ValueError(f"port fetch is for {fetch.width}x{fetch.height} frames, the arbiter for {width}x{height}")
+    width, height, feature_words, depth, burst, fetch_burst, host_burst, counter_bits, amap = check_masters(
+        clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, width=width, height=height,
+        feature_words=feature_words, depth=depth, burst=burst, fetch_burst=fetch_burst, host_burst=host_burst,
+        counter_bits=counter_bits)
+    check_bundle("cmd", cmd, SramCmd)
+    check_bundle("rsp", rsp, SramRsp)
     if cmd.tag_bits != TAG_BITS or rsp.tag_bits != TAG_BITS:
-        raise ValueError(f"ports cmd and rsp need {TAG_BITS} tag bits, got {cmd.tag_bits} and {rsp.tag_bits}")
-    if len(stat.addr) < 5 or len(stat.data) != 32:
-        raise ValueError("port stat needs at least 5 address bits and 32 data bits")
-    try:
-        amap = AddressMap(width, height, feature_words)
-    except ValueError as e:
-        raise ValueError(f"parameters width, height, feature_words: {e}") from None
+        raise block_error(f"ports cmd and rsp need {TAG_BITS} tag bits, got {cmd.tag_bits} and {rsp.tag_bits}")
+    check_distinct(dict(fetch=fetch, stat=stat, cmd=cmd), dict(clk=clk, rst=rst, cam0=cam0, cam1=cam1, rect=rect,
+                                                             feat=feat, host=host, ctl=ctl, rsp=rsp))
 
     insts = []
     heads = [Head() for _ in range(NM)]
@@ -180,19 +192,21 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
         return (Signal(intbv(0)[ENTRY_BITS:]), Signal(bool(0)), Signal(bool(0)),
                 Signal(intbv(0, min=0, max=depth + 1)))
 
-    wkw = dict(depth=depth, burst=burst, urgent_level=depth * 3 // 4)
+    wkw = dict(depth=depth, burst=burst)
     for c, (q, run, arm) in enumerate(((cam0, run0, arm0), (cam1, run1, arm1))):
         e_in, push, push_eof, count = fifo_signals()
         insts.append(frame_writer(clk, rst, e_in, push, push_eof, count, heads[c], sides[c], *dummy_counts(),
-                                  base0=amap.camera(c, 0), base1=amap.camera(c, 1), always_urgent=True, **wkw))
+                                  base0=amap.camera(c, 0), base1=amap.camera(c, 1), urgent=True, **wkw))
         insts.append(camera_in(clk, rst, q, push, e_in, push_eof, count, run, arm, depth=depth))
     e_in, push, push_eof, count = fifo_signals()
+    # The rectified stream cannot wait either: its writer is urgent like the cameras' (its rate is bounded
+    # by the stream's: one word per two beats at most, in the system one per 8 fetch reads).
     insts.append(frame_writer(clk, rst, e_in, push, push_eof, count, heads[RECT], s_r, *dummy_counts(),
-                              base0=amap.rectified(0), base1=amap.rectified(1), always_urgent=False, **wkw))
+                              base0=amap.rectified(0), base1=amap.rectified(1), urgent=True, **wkw))
     insts.append(rect_in(clk, rst, rect, push, e_in, push_eof, count, rect_lost, depth=depth))
     e_in, push, push_eof, count = fifo_signals()
     insts.append(frame_writer(clk, rst, e_in, push, push_eof, count, heads[FEAT], s_f, lcounts[0], lcounts[1], lovf,
-                              base0=amap.features(0), base1=amap.features(1), always_urgent=False, **wkw))
+                              base0=amap.features(0), base1=amap.features(1), urgent=False, **wkw))
     insts.append(feature_in(clk, rst, feat, push, e_in, push_eof, count, depth=depth, capacity=feature_words))
 
     # ---- readers ------------------------------------------------------------------------------
@@ -233,6 +247,8 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     nxt_v = Signal(bool(0))
     nxt_urg = Signal(bool(0))
     preempt = Signal(bool(0))
+    served = Signal(bool(0))  # the current turn has moved a word
+    last1 = Signal(intbv(NM - 1, min=0, max=NM))  # the last non-urgent master to start a turn
     nxt_c = Signal(intbv(0, min=0, max=NM))
     nxt_vc = Signal(bool(0))
     nxt_urgc = Signal(bool(0))
@@ -260,11 +276,14 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
 
     @always_comb
     def pools():
+        # the urgent masters take turns among themselves, the others among themselves (each round robin
+        # keeps its own place, so urgent turns in between do not favour one of the others)
         if urg != 0:
             pool.next = urg
+            above.next = AFTER[own]
         else:
             pool.next = startv
-        above.next = AFTER[own]
+            above.next = AFTER[last1]
 
     @always_comb
     def masked():
@@ -291,7 +310,9 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
             nxt_c.next = 5
         nxt_vc.next = cand != 0
         nxt_urgc.next = urg != 0
-        preempt_c.next = own_v and not own_urg and urg != 0
+        # an urgent master ends a non-urgent turn, but only after that turn moved a word: every turn
+        # moves at least one, so the round robin cannot be starved by preemption
+        preempt_c.next = own_v and not own_urg and urg != 0 and served
 
     @always_comb
     def issue_logic():
@@ -321,8 +342,12 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
             own_v.next = nxt_v
             own_urg.next = nxt_urg
             beats.next = blen
+            served.next = False
+            if nxt_v and not nxt_urg:
+                last1.next = nxt
         elif issue:
             beats.next = beats - 1
+            served.next = True
         if issue:
             slot_v.next = True
         elif cmd.ready:

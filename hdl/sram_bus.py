@@ -63,9 +63,20 @@ import numbers
 
 from myhdl import Signal, intbv
 
+from eyestereo.hdl.common.checks import block_error
 from eyestereo.tools.sram import ADDR_BITS, DATA_BITS
 
-__all__ = ["SramPins", "SramCmd", "SramRsp", "HostPort", "StatPort"]
+__all__ = ["SramPins", "SramCmd", "SramRsp", "HostPort", "StatPort", "check_bundle"]
+
+
+def check_bundle(name: str, port, cls) -> None:
+    """An interface port of class ``cls`` (SramPins, SramCmd, ..., FrameControl), else a ValueError that
+    names the port and the block."""
+    if not isinstance(port, cls):
+        got = "None" if port is None else (f"{type(port).__name__} {port!r}"[:60] if isinstance(port, (int, str))
+                                           else type(port).__name__)
+        fields = f" ({', '.join(cls().fields())})" if hasattr(cls, "fields") else ""
+        raise block_error(f"port {name} must be a {cls.__name__}{fields}, got {got}")
 
 
 def _bits(name: str, value, lo: int, hi: int) -> int:

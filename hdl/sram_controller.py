@@ -2,27 +2,24 @@
 
 from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv
 
-from eyestereo.hdl.common.checks import check_choice, check_clock, check_int, check_reset
+from eyestereo.hdl.common.checks import block_error, check_choice, check_clock, check_distinct, check_int, check_reset
 from eyestereo.hdl.common.registers import delay
-from eyestereo.hdl.sram_bus import SramCmd, SramPins, SramRsp
+from eyestereo.hdl.sram_bus import SramCmd, SramPins, SramRsp, check_bundle
 from eyestereo.tools.models.sram_controller import write_block_window
 from eyestereo.tools.sram import KINDS
 
 
 def _check_ports(cmd, rsp, sram):
-    if not isinstance(cmd, SramCmd):
-        raise ValueError(f"port cmd must be an SramCmd, got {type(cmd).__name__}")
-    if not isinstance(rsp, SramRsp):
-        raise ValueError(f"port rsp must be an SramRsp, got {type(rsp).__name__}")
-    if not isinstance(sram, SramPins):
-        raise ValueError(f"port sram must be SramPins, got {type(sram).__name__}")
+    check_bundle("cmd", cmd, SramCmd)
+    check_bundle("rsp", rsp, SramRsp)
+    check_bundle("sram", sram, SramPins)
     if cmd.addr_bits != sram.addr_bits:
-        raise ValueError(f"port cmd has {cmd.addr_bits} address bits, the SRAM pins {sram.addr_bits}")
+        raise block_error(f"port cmd has {cmd.addr_bits} address bits, the SRAM pins {sram.addr_bits}")
     for name, b in (("cmd", cmd.data_bits), ("rsp", rsp.data_bits)):
         if b != sram.data_bits:
-            raise ValueError(f"port {name} has {b} data bits, the SRAM pins {sram.data_bits}")
+            raise block_error(f"port {name} has {b} data bits, the SRAM pins {sram.data_bits}")
     if rsp.tag_bits != cmd.tag_bits:
-        raise ValueError(f"port rsp has {rsp.tag_bits} tag bits, cmd {cmd.tag_bits}: they must match")
+        raise block_error(f"port rsp has {rsp.tag_bits} tag bits, cmd {cmd.tag_bits}: they must match")
 
 
 @block
@@ -59,6 +56,7 @@ def sram_controller(clk, rst, cmd, rsp, sram, *, kind: str = "nobl", read_latenc
     check_clock(clk)
     check_reset(rst)
     _check_ports(cmd, rsp, sram)
+    check_distinct(dict(rsp=rsp, sram=sram), dict(clk=clk, rst=rst, cmd=cmd))
     kind = check_choice("kind", kind, KINDS)
     lat = check_int("read_latency", read_latency, 1, 3)
 

@@ -32,7 +32,7 @@ class Head:
     """One master's next access, as the arbiter sees it.
 
     ``req``: an access is ready; ``start``: the master may start a turn (a writer: a burst is waiting);
-    ``urgent``: it must be served before the round robin (camera writers, a nearly full writer);
+    ``urgent``: it must be served before the round robin (the writers of streams that cannot wait);
     ``we, addr, wdata, be``: the access; ``idx``: the fetch index returned with read data;
     ``grant`` (from the arbiter): the access is issued at this edge.
     """
@@ -52,7 +52,7 @@ class Head:
 # ------------------------------------------------------------------------------------------------------
 @block
 def writer_issue(clk, rst, entry, valid, count, pop, push_eof, head, side, lcount0, lcount1, lovf,
-                 *, base0: int, base1: int, depth: int, burst: int, urgent_level: int, always_urgent: bool):
+                 *, base0: int, base1: int, depth: int, burst: int, urgent: bool):
     """The SRAM side of a writer: its FIFO's words to consecutive addresses of a buffer, frame by frame.
 
     A frame's first word (``sof``) takes a buffer from the double buffer when it reaches the head of the
@@ -105,10 +105,7 @@ def writer_issue(clk, rst, entry, valid, count, pop, push_eof, head, side, lcoun
         # start/urgent registered (a clock late: only the arbiter's next-turn choice reads them)
         wants = count >= burst or eofs != 0
         head.start.next = wants
-        if always_urgent:
-            head.urgent.next = wants
-        else:
-            head.urgent.next = count >= urgent_level
+        head.urgent.next = wants and urgent
         # a frame's first word at the head asks the double buffer for a buffer (answered a clock later)
         if side.p_grant:
             side.p_start.next = False
@@ -487,7 +484,7 @@ def host_slave(clk, rst, hp, head):
 
 @block
 def frame_writer(clk, rst, entry_in, push, push_eof, count, head, side, lcount0, lcount1, lovf, *, base0: int,
-                 base1: int, depth: int, burst: int, urgent_level: int, always_urgent: bool):
+                 base1: int, depth: int, burst: int, urgent: bool):
     """A writer's FIFO (LUT-RAM, ``depth`` entries) and its SRAM side (:func:`writer_issue`); the input side
     (:func:`camera_in`, :func:`rect_in`, :func:`feature_in`) pushes ``entry_in``."""
     entry = Signal(intbv(0)[ENTRY_BITS:])
@@ -495,5 +492,5 @@ def frame_writer(clk, rst, entry_in, push, push_eof, count, head, side, lcount0,
     valid = Signal(bool(0))
     fifo = sync_fifo(clk, rst, entry_in, push, entry, pop, count, valid, depth=depth)
     issue = writer_issue(clk, rst, entry, valid, count, pop, push_eof, head, side, lcount0, lcount1, lovf, base0=base0,
-                         base1=base1, depth=depth, burst=burst, urgent_level=urgent_level, always_urgent=always_urgent)
+                         base1=base1, depth=depth, burst=burst, urgent=urgent)
     return fifo, issue

@@ -2,9 +2,9 @@
 
 from myhdl import block
 
-from eyestereo.hdl.common.checks import check_choice, check_int
-from eyestereo.hdl.sram_arbiter import TAG_BITS, sram_arbiter
-from eyestereo.hdl.sram_bus import SramCmd, SramPins, SramRsp
+from eyestereo.hdl.common.checks import check_choice, check_distinct, check_int
+from eyestereo.hdl.sram_arbiter import TAG_BITS, check_masters, sram_arbiter
+from eyestereo.hdl.sram_bus import SramCmd, SramPins, SramRsp, check_bundle
 from eyestereo.hdl.sram_controller import sram_controller
 from eyestereo.tools.sram import KINDS
 
@@ -33,6 +33,13 @@ def sram_subsystem(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, sra
 
     Resources: see docs/sram.md.
     """
+    # every check here, so that a message names this block (not the arbiter or controller inside)
+    check_masters(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, width=width, height=height,
+                  feature_words=feature_words, depth=depth, burst=burst, fetch_burst=fetch_burst,
+                  host_burst=host_burst, counter_bits=counter_bits)
+    check_bundle("sram", sram, SramPins)
+    check_distinct(dict(fetch=fetch, stat=stat, sram=sram), dict(clk=clk, rst=rst, cam0=cam0, cam1=cam1, rect=rect,
+                                                               feat=feat, host=host, ctl=ctl))
     kind = check_choice("kind", kind, KINDS)
     read_latency = check_int("read_latency", read_latency, 1, 3)
     cmd = SramCmd(tag_bits=TAG_BITS)

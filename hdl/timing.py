@@ -1,146 +1,203 @@
-"""Logic depth and an estimated clock period of a Yosys ``synth_xilinx -family xc3se`` netlist.
+"""Timing pictures: WaveDrom diagrams of every handshake, rendered offline, next to the ASCII ones.
 
-There is no open place-and-route for the Spartan-3E, so this is an *estimate*, not a timing sign-off:
-the longest register-to-register path of the mapped netlist (Yosys ``write_json``), weighed with the
-XC3S500E -4 speed grade's cell delays from its data sheet and one fixed delay per net (no placement,
-no fan-out model). It shows how many LUT levels a block has between flip-flops and where its longest
-path runs; a real place-and-route adds routing that depends on the placement.
+``python -m eyestereo.hdl.timing`` (``make timing``) renders each ``docs/wavedrom/<name>.json`` (WaveJSON)
+to ``docs/img/timing/<name>.svg`` with yowasp-wavedrom (WaveDrom in a bundled JavaScript engine: no
+browser, no network) and writes ``docs/timing.md``: per diagram its title, the ASCII diagram and the
+SVG. The committed SVGs and ``docs/timing.md`` are this command's output.
 
-``python -m eyestereo.hdl.timing --block NAME`` prints the estimate and the path.
+Each JSON file carries, besides WaveDrom's ``signal``/``head``/``config``, an ``eyestereo`` object
+(WaveDrom ignores it; it is removed before rendering):
+
+``title``
+    the section heading in ``docs/timing.md``;
+``ascii``
+    where the ASCII diagram lives: ``"module"`` or ``"module:object"`` whose docstring has a literal
+    block (after ``::``) with a ``cycle`` line, e.g. ``"eyestereo.hdl.stream"``; the diagram in the
+    docs is read from there, so the two stay one;
+``ascii_lines``
+    instead of ``ascii``, for a contract whose interface class does not exist yet (from INTERFACES.md):
+    the ASCII diagram itself;
+``defined_by``
+    optional: who defines the interface;
+``order``
+    optional sort key (default 100; then by file name).
+
+Interfaces that are announced but have no diagram yet (:data:`EXPECTED`) are listed as "not yet
+available" so that their owners know where to add one.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
-import subprocess
+import os
+import re
 import sys
-from collections import defaultdict
-from functools import lru_cache
 from pathlib import Path
 
-#: Spartan-3E -4 cell delays in ns (data sheet DS312 switching characteristics; rounded): LUT input to
-#: output (T_ILO), the F5/FX muxes, the carry chain per bit, XOR of the carry chain, a flip-flop's clock
-#: to output (T_CKO) and its setup (T_DICK / T_CECK), distributed RAM read (like a LUT).
-DELAY = {"LUT": 0.66, "MUXF": 0.45, "MUXCY": 0.08, "MUXCY_IN": 0.70, "XORCY": 0.75, "INV": 0.66,
-         "CKO": 0.60, "SETUP": 0.55, "RAM": 0.66}
-#: Assumed delay of one net between slices (the part that placement decides).
-NET = 0.70
+ROOT = Path(__file__).resolve().parent.parent
+JSON_DIR = ROOT / "docs" / "wavedrom"
+SVG_DIR = ROOT / "docs" / "img" / "timing"
+DOC = ROOT / "docs" / "timing.md"
 
-SEQ = ("FDRE", "FDSE", "FDCE", "FDPE", "FD", "FDR", "FDS", "FDE")
-
-
-def _kind(t: str) -> str:
-    if t.startswith("LUT"):
-        return "LUT"
-    if t.startswith("MUXF"):
-        return "MUXF"
-    if t.startswith("RAM"):
-        return "RAM"
-    return t
+#: Diagrams the system needs whose interfaces other work items define: file stem -> what it is.
+EXPECTED = {
+    "sram": "SRAM pins and the controller's word port (the SRAM work, issue 12)",
+    "register_bus": "Register bus, Wishbone B4 or AXI4-Lite (the complete system, issue 15)",
+    "feature_words": "Feature words (the stereo Harris work, issue 14)",
+}
 
 
-def analyse(netlist: dict, top: str) -> dict:
-    """Longest flip-flop/port to flip-flop/port path of ``top`` (a Yosys JSON netlist)."""
-    mod = netlist["modules"][top]
-    names = {}
-    for n, v in mod["netnames"].items():
-        for b in v["bits"]:
-            if isinstance(b, int) and (b not in names or not n.startswith("$")):
-                names[b] = n
-    drivers: dict[int, tuple[str, str]] = {}
-    cells = mod["cells"]
-    for cn, c in cells.items():
-        for port, d in c["port_directions"].items():
-            if d == "output":
-                for b in c["connections"][port]:
-                    if isinstance(b, int):
-                        drivers[b] = (cn, port)
-    sinks = defaultdict(list)
-    for cn, c in cells.items():
-        for port, d in c["port_directions"].items():
-            if d == "input":
-                for b in c["connections"][port]:
-                    if isinstance(b, int):
-                        sinks[cn].append((port, b))
-
-    @lru_cache(maxsize=None)
-    def arrival(bit: int) -> tuple[float, tuple]:
-        """Arrival time at a net and the path (cell names) that sets it."""
-        if bit not in drivers:
-            return 0.0, ()                      # a top-level input: registered outside
-        cn, port = drivers[bit]
-        t = cells[cn]["type"]
-        k = _kind(t)
-        if t in SEQ or t == "BUFG":
-            return DELAY["CKO"], (cn,)
-        if k == "RAM" and port in ("SPO", "DPO"):
-            # asynchronous read: SPO from the write address A*, DPO from the read address DPRA*
-            pre = "DPRA" if port == "DPO" else "A"
-            ins = [b for p, b in sinks[cn] if p.startswith(pre) and not (pre == "A" and p.startswith("ADDR"))]
-            best = max((arrival(b) for b in ins), default=(0.0, ()))
-            return best[0] + NET + DELAY["RAM"], best[1] + (cn,)
-        best = (0.0, ())
-        for p, b in sinks[cn]:
-            a = arrival(b)
-            # carry-chain and in-slice mux inputs need no general routing
-            if k == "MUXCY" and p == "CI" or k == "XORCY" and p == "CI" or k == "MUXF" and p in ("I0", "I1"):
-                tin = a[0]
-            else:
-                tin = a[0] + NET
-            if tin > best[0]:
-                best = (tin, a[1])
-        d = DELAY["MUXCY"] if k == "MUXCY" else DELAY.get(k, DELAY["LUT"])
-        return best[0] + d, best[1] + (cn,)
-
-    sys.setrecursionlimit(100000)
-    worst = (0.0, (), "")
-    for cn, c in cells.items():
-        if c["type"] in SEQ:
-            for p, b in sinks[cn]:
-                if p == "C":
-                    continue
-                a = arrival(b)
-                t = a[0] + NET + DELAY["SETUP"]
-                if t > worst[0]:
-                    worst = (t, a[1] + (cn,), p)
-    luts = sum(1 for cn in worst[1] if _kind(cells[cn]["type"]) in ("LUT", "RAM", "INV"))
-    path = [f"{cells[cn]['type']}:{cn}" for cn in worst[1]]
-    return dict(period_ns=round(worst[0], 2), fmax_mhz=round(1000 / worst[0], 1) if worst[0] else None,
-                lut_levels=luts, path=path, endpoint_port=worst[2])
+class TimingError(ValueError):
+    """A diagram file is broken (bad JSON, no title, an ASCII source that does not resolve)."""
 
 
-def estimate(name: str, out: Path, **params) -> dict:
-    """Synthesize ``name`` (as make synth does) and estimate its clock period."""
-    from eyestereo.hdl.convert import convert
-    from eyestereo.hdl.synth import yosys_command
+def load(path: Path) -> dict:
+    try:
+        d = json.loads(Path(path).read_text())
+    except (OSError, json.JSONDecodeError) as e:
+        raise TimingError(f"{path}: {e}") from None
+    meta = d.get("eyestereo")
+    if not isinstance(d.get("signal"), list) or not isinstance(meta, dict) or not meta.get("title"):
+        raise TimingError(f"{path}: needs a 'signal' list and an 'eyestereo' object with a 'title'")
+    if ("ascii" in meta) == ("ascii_lines" in meta):
+        raise TimingError(f"{path}: the 'eyestereo' object needs exactly one of 'ascii' and 'ascii_lines'")
+    _check_waves(path, d["signal"])
+    return d
 
-    d = Path(out) / f"timing_{name}"
-    d.mkdir(parents=True, exist_ok=True)
-    (vfile,) = convert(name, d, hdl="Verilog", **params)
-    script = (f"read_verilog {vfile.name}; synth_xilinx -family xc3se -noiopad -top {name}; "
-              f"write_json netlist.json")
-    r = subprocess.run(yosys_command() + ["-q", "-p", script], cwd=d, capture_output=True, text=True)
-    if r.returncode != 0 or not (d / "netlist.json").exists():
-        raise RuntimeError(f"yosys failed on {name}:\n{r.stderr[-2000:]}")
-    res = analyse(json.loads((d / "netlist.json").read_text()), name)
-    res["block"] = name
-    return res
+
+def _check_waves(path: Path, signals) -> None:
+    """Every wave one character per clock, as long as the first; one data label per data character."""
+    length = None
+    for s in signals:
+        for item in (s[1:] if isinstance(s, list) else [s]):
+            if not isinstance(item, dict) or "wave" not in item:
+                continue
+            w = item["wave"]
+            length = length or len(w)
+            if len(w) != length:
+                raise TimingError(f"{path}: wave of {item.get('name')!r} has {len(w)} clocks, the first has {length}")
+            if "data" in item:
+                n = sum(c in "=2345" for c in w)
+                if n != len(item["data"]):
+                    raise TimingError(f"{path}: {item.get('name')!r} has {n} data slots and {len(item['data'])} labels")
+
+
+def render(d: dict) -> str:
+    """The SVG of a WaveJSON diagram (our ``eyestereo`` metadata left out)."""
+    import yowasp_wavedrom
+
+    src = {k: v for k, v in d.items() if k != "eyestereo"}
+    svg = yowasp_wavedrom.render(src)
+    if not isinstance(svg, str) or "<svg" not in svg[:200]:
+        raise TimingError(f"WaveDrom returned no SVG for {d['eyestereo']['title']!r}")
+    return svg
+
+
+def ascii_block(doc: str) -> str:
+    """The literal block (after ``::``) of a docstring that contains a ``cycle`` line, dedented."""
+    lines = doc.splitlines()
+    for i, line in enumerate(lines):
+        if not line.rstrip().endswith("::"):
+            continue
+        block: list[str] = []
+        for l in lines[i + 1:]:
+            if l.strip() and not l.startswith((" ", "\t")):
+                break
+            if l.strip() and block and len(l) - len(l.lstrip()) <= len(lines[i]) - len(lines[i].lstrip()):
+                break
+            block.append(l)
+        text = "\n".join(block).strip("\n")
+        if re.search(r"^\s*cycle\b", text, re.M):
+            indent = min(len(l) - len(l.lstrip()) for l in text.splitlines() if l.strip())
+            return "\n".join(l[indent:] for l in text.splitlines())
+    raise TimingError("no literal block with a 'cycle' line in the docstring")
+
+
+def ascii_for(meta: dict) -> tuple[str, str]:
+    """(ASCII diagram, where it comes from) for a diagram's metadata."""
+    if "ascii_lines" in meta:
+        return "\n".join(meta["ascii_lines"]), "INTERFACES.md contract (no interface class yet)"
+    mod, _, obj = meta["ascii"].partition(":")
+    try:
+        target = importlib.import_module(mod)
+        for part in filter(None, obj.split(".")):
+            target = getattr(target, part)
+    except (ImportError, AttributeError) as e:
+        raise TimingError(f"ASCII source {meta['ascii']!r} does not resolve: {e}") from None
+    try:
+        return ascii_block(target.__doc__ or ""), f"docstring of `{meta['ascii']}`"
+    except TimingError as e:
+        raise TimingError(f"{meta['ascii']}: {e}") from None
+
+
+def diagrams(json_dir: Path = JSON_DIR) -> list[tuple[str, dict]]:
+    """(stem, diagram) of every JSON file, in document order."""
+    items = [(p.stem, load(p)) for p in sorted(Path(json_dir).glob("*.json"))]
+    return sorted(items, key=lambda it: (it[1]["eyestereo"].get("order", 100), it[0]))
+
+
+def document(items: list[tuple[str, dict]], svg_rel: str) -> str:
+    out = ["# Timing diagrams", "",
+           "Every handshake of the library, drawn twice: the ASCII diagram from the interface's or block's "
+           "docstring (what `help()` shows) and the same timing as a WaveDrom picture. Written by "
+           "`make timing` (`eyestereo.hdl.timing`) from `docs/wavedrom/*.json`; edit those and the docstrings, "
+           "not this file.", "",
+           "Signals are sampled on the rising clock edge; `#` high, `_` low, `.` don't care in the ASCII "
+           "diagrams.", ""]
+    for stem, d in items:
+        meta = d["eyestereo"]
+        text, where = ascii_for(meta)
+        out += [f"## {meta['title']}", ""]
+        if meta.get("defined_by"):
+            out += [f"Defined by: {meta['defined_by']}.", ""]
+        out += [f"ASCII ({where}):", "", "```", text, "```", "",
+                f"![{meta['title']}]({svg_rel}/{stem}.svg)", "",
+                f"Source: `docs/wavedrom/{stem}.json`.", ""]
+    missing = [(k, v) for k, v in EXPECTED.items() if k not in {s for s, _ in items}]
+    if missing:
+        out += ["## Not yet available", ""]
+        out += [f"* {v}: no diagram yet (add `docs/wavedrom/{k}.json`)." for k, v in missing]
+        out.append("")
+    return "\n".join(out)
+
+
+def _write(path: Path, text: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def build(json_dir: Path = JSON_DIR, svg_dir: Path = SVG_DIR, doc: Path = DOC) -> list[Path]:
+    """Render every diagram and write the document; returns the files written. Nothing is written when
+    any diagram fails."""
+    items = diagrams(json_dir)
+    svgs = {stem: render(d) for stem, d in items}
+    text = document(items, os.path.relpath(svg_dir, Path(doc).parent))
+    written = []
+    for stem, svg in svgs.items():
+        p = Path(svg_dir) / f"{stem}.svg"
+        _write(p, svg)
+        written.append(p)
+    _write(Path(doc), text)
+    return written + [Path(doc)]
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description="Estimate a block's clock period on the Spartan-3E -4 (no P&R).")
-    ap.add_argument("--block", required=True)
-    ap.add_argument("--out", default="build/synth", type=Path)
+    ap = argparse.ArgumentParser(description="Render the WaveDrom timing diagrams and write docs/timing.md.")
+    ap.add_argument("--json-dir", type=Path, default=JSON_DIR)
+    ap.add_argument("--svg-dir", type=Path, default=SVG_DIR)
+    ap.add_argument("--doc", type=Path, default=DOC)
     args = ap.parse_args(argv)
     try:
-        res = estimate(args.block, args.out)
-    except (RuntimeError, ValueError) as e:
-        print(f"timing: {e}", file=sys.stderr)
+        files = build(args.json_dir, args.svg_dir, args.doc)
+    except (TimingError, ImportError) as e:
+        print(f"make timing: {e}", file=sys.stderr)
         return 1
-    print(f"{res['block']}: {res['period_ns']} ns ({res['fmax_mhz']} MHz estimated), {res['lut_levels']} LUT levels")
-    for p in res["path"]:
-        print("   ", p)
+    for f in files:
+        print(f)
     return 0
 
 

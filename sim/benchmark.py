@@ -9,7 +9,8 @@ Every figure is measured here, on this machine, by running the GHDL benches and 
   (x + r, y + r)) to that output beat, over every pixel of both frames that has such an input beat.
 * simulation speed: simulated clock cycles per wall-clock second of the whole bench run (conversion,
   GHDL elaboration, cocotb start-up included) and of the simulation alone (cocotb's own timing).
-* resources: :mod:`eyestereo.hdl.synth` (Yosys ``synth_xilinx -family xc3se``).
+Resources and fmax are ``make synth``'s (:mod:`eyestereo.hdl.synth`): it writes its own section of
+the same file (between ``<!-- synth:begin -->`` and ``<!-- synth:end -->``), which this script keeps.
 """
 
 from __future__ import annotations
@@ -62,15 +63,6 @@ CASES = [
 
 
 NOTES = """
-### Against the thesis (Table 6.3, Xilinx ISE; here Yosys, so a like-for-like comparison only roughly)
-
-* Every Harris module is at or under the thesis except the two smallest: NMS 1x1 (10 LUTs vs 7: the
-  "> 0" test of a 20-bit signed value needs a 19-input OR) and pre-threshold 1x1 (21 vs 20: the
-  threshold register keeps a synchronous reset so that it reads 0 after `rst`, as the issue asks).
-* harris_mono (4x4 blocks, NMS 3x3) uses 1324 LUTs + 20 LUT-RAM, 8 RAMB16 and 7 MULT18X18; the thesis's
-  modules add up to 1812 LUTs, 8 block RAMs and 8 multipliers. Savings come from the separable NMS with
-  comparisons only against the centre, the 4-multiplier cornerness (k * t shares t, trace^2 = 4 t^2)
-  and the thresholds held in LUT-RAM.
 * The simulation speed of the bigger designs is GHDL's (mcode back end) evaluation of MyHDL's many
   small processes, not cocotb's: the Sobel bench runs at about 11 k clocks/s, harris_mono at 2.5 k.
 """
@@ -115,7 +107,7 @@ def _version(cmd: list[str]) -> str:
         return "?"
 
 
-def report(results: list[dict], resources: list[dict]) -> str:
+def report(results: list[dict]) -> str:
     import cocotb
     import myhdl
 
@@ -143,8 +135,16 @@ def report(results: list[dict], resources: list[dict]) -> str:
             "centred on (x, y) needs, to the output beat of (x, y); the output stream therefore runs "
             "r lines + r pixels + that many clocks behind the input. For the line delay it is input "
             "beat to output beat.", ""]
-    out.append(synth.table(resources).replace("# Resources per block", "## Resources per block"))
     return "\n".join(out)
+
+
+def synth_section(doc: Path) -> str:
+    """The section make synth wrote into ``doc`` (markers included), or a pointer to make synth."""
+    old = doc.read_text() if doc.exists() else ""
+    i, j = old.find(synth.DOC_BEGIN), old.find(synth.DOC_END)
+    if i >= 0 and j > i:
+        return old[i:j + len(synth.DOC_END)] + "\n"
+    return f"{synth.DOC_BEGIN}\nResources and fmax: run `make synth`.\n{synth.DOC_END}\n"
 
 
 def main(argv=None) -> int:
@@ -155,15 +155,10 @@ def main(argv=None) -> int:
     for case in CASES:
         print(f"benchmark: {case[0]} ...", flush=True)
         results.append(measure(case))
-    resources = []
-    for label, name, params in synth.configurations():
-        print(f"benchmark: synthesizing {label} ...", flush=True)
-        resources.append(synth.synth_block(name, BUILD.parent / "synth", label=label, **params))
-    text = report(results, resources)
-    text += NOTES
+    text = report(results) + NOTES + "\n" + synth_section(args.out)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(text)
-    (BUILD.parent / "bench.json").write_text(json.dumps(dict(results=results, resources=resources), indent=2))
+    (BUILD.parent / "bench.json").write_text(json.dumps(dict(results=results), indent=2))
     print(text)
     return 0
 

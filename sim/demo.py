@@ -5,13 +5,17 @@ for :func:`eyestereo.hdl.sobel.sobel` and for :func:`eyestereo.hdl.harris_mono.h
 by GHDL under cocotb; each bench checks the output bit for bit against the numpy model before the
 pictures are written. The Harris run is made twice, as in thesis Fig. 5.3/5.4: one global threshold,
 and 4x4 blocks with a threshold each, both aiming at the same number of corners.
+
+The output fits on one screen: one line per step (:class:`eyestereo.sim.steps.StepRunner`: what ran,
+on what, the result, where the pictures are); the simulators' own output goes to
+``build/demo/logs/<step>.log``.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
-import time
 from pathlib import Path
 
 import cv2
@@ -19,6 +23,7 @@ import numpy as np
 
 from eyestereo.sim.bench import make_frame
 from eyestereo.sim.runner import ROOT, run_bench
+from eyestereo.sim.steps import StepFailed, StepRunner
 from eyestereo.tools.models import harris_mono as hm
 from eyestereo.tools.models import prethreshold as pt
 from eyestereo.tools.models import sobel as model
@@ -76,53 +81,54 @@ def run_harris(out: Path, frame: np.ndarray, blocks: tuple[int, int]) -> tuple[n
     return flags * mask, report
 
 
+def write_png(path: Path, img: np.ndarray) -> None:
+    if not cv2.imwrite(str(path), img):
+        raise OSError(f"cannot write {path}")
+
+
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description="Run the Sobel VHDL on a real image in GHDL and write PNGs.")
+    ap = argparse.ArgumentParser(description="Run the Sobel and Harris VHDL on a real image in GHDL and write PNGs.")
     ap.add_argument("--out", type=Path, default=ROOT / "build" / "demo")
     args = ap.parse_args(argv)
     out: Path = args.out.resolve()
     out.mkdir(parents=True, exist_ok=True)
-    dump = out / "sobel_frames.npy"
-    t0 = time.perf_counter()
-    try:
+    steps = StepRunner(out / "logs", width=29)
+    frame = make_frame(f"file:{IMAGE}", WIDTH, HEIGHT)
+    write_png(out / "input.png", frame.astype(np.uint8))
+    rel = os.path.relpath(out)
+    steps.say(f"make demo: {IMAGE} (Middlebury Tsukuba, left view), centre {WIDTH}x{HEIGHT}, through the generated "
+              f"VHDL in GHDL; pictures in {rel}/, simulator logs in {rel}/logs/")
+
+    def sobel_step():
+        dump = out / "sobel_frames.npy"
         report = run_bench("sobel", "tb_sobel", dict(frames=[f"file:{IMAGE}"], duty=1.0, dump=str(dump)),
                            name="demo", params=dict(width=WIDTH, height=HEIGHT))
-    except (AssertionError, RuntimeError) as e:
-        print(f"make demo: the GHDL run failed: {e}", file=sys.stderr)
-        return 1
-    seconds = time.perf_counter() - t0
-    words = np.load(dump)[0]
-    ix, iy = model.unpack(words)
-    frame = make_frame(f"file:{IMAGE}", WIDTH, HEIGHT)
-    _, _, mask = model.sobel(frame)
-    written = {
-        "input.png": frame.astype(np.uint8),
-        "sobel_abs_ix.png": gradient_picture(ix, mask),
-        "sobel_abs_iy.png": gradient_picture(iy, mask),
-    }
-    for name, img in written.items():
-        if not cv2.imwrite(str(out / name), img):
-            print(f"make demo: cannot write {out / name}", file=sys.stderr)
-            return 1
-    print(f"Sobel VHDL in GHDL on {IMAGE} ({WIDTH}x{HEIGHT}): {report['pixels_compared']} interior pixels "
-          f"bit-exact with the numpy model, {report['cycles']} clock cycles simulated in {seconds:.1f} s")
-    for name in written:
-        print(f"  {out / name}")
-    for blocks in ((1, 1), (4, 4)):
-        t0 = time.perf_counter()
-        try:
+        words = np.load(dump)[0]
+        undefined = int((words < 0).sum())  # the bench stores a beat with U/X bits as -1
+        ix, iy = model.unpack(np.where(words < 0, 0, words))
+        _, _, mask = model.sobel(frame)
+        write_png(out / "sobel_abs_ix.png", gradient_picture(ix, mask))
+        write_png(out / "sobel_abs_iy.png", gradient_picture(iy, mask))
+        und = f", {undefined} border words undefined (U/X)" if undefined else ""
+        return (f"{report['pixels_compared']} interior pixels bit-exact with the model{und}, "
+                f"{report['cycles']} clocks -> sobel_abs_ix.png, sobel_abs_iy.png")
+
+    def harris_step(blocks):
+        def step():
             flags, rep = run_harris(out, frame, blocks)
-        except (AssertionError, RuntimeError) as e:
-            print(f"make demo: the GHDL run of harris_mono failed: {e}", file=sys.stderr)
-            return 1
-        name = f"harris_{blocks[0]}x{blocks[1]}.png"
-        if not cv2.imwrite(str(out / name), draw_corners(frame, flags, blocks)):
-            print(f"make demo: cannot write {out / name}", file=sys.stderr)
-            return 1
-        label = "global threshold" if blocks == (1, 1) else f"{blocks[0]}x{blocks[1]} block thresholds"
-        print(f"harris_mono VHDL in GHDL, {label}: {int(flags.sum())} corners, {rep['pixels_compared']} flags "
-              f"bit-exact with the model, {time.perf_counter() - t0:.1f} s\n  {out / name}")
-    return 0
+            name = f"harris_{blocks[0]}x{blocks[1]}.png"
+            write_png(out / name, draw_corners(frame, flags, blocks))
+            return f"{int(flags.sum())} corners, {rep['pixels_compared']} flags bit-exact with the model -> {name}"
+        return step
+
+    try:
+        steps.run("sobel (VHDL, GHDL)", sobel_step)
+        steps.run("harris_mono, 1 threshold", harris_step((1, 1)))
+        steps.run("harris_mono, 4x4 thresholds", harris_step((4, 4)))
+    except StepFailed:
+        return 1
+    steps.say(f"3 steps, every output bit-exact, {steps.seconds:.0f} s; input.png and the pictures are in {rel}/")
+    return steps.finish()
 
 
 if __name__ == "__main__":

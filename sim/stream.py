@@ -133,3 +133,98 @@ class StreamSink:
                     self.asm.push(data, bool(int(self.eol.value)), bool(int(self.eof.value)))
                 except (ProtocolError, ValueError) as e:
                     self.error = ProtocolError(f"cycle {self.cycle}: {e}")
+
+
+class BeatSource(StreamSource):
+    """A source for any beats, protocol faults included: ``(data, eol, eof)`` or ``(data, eol, eof, cam)``.
+
+    Unlike :class:`StreamSource` it drives ``<prefix>_cam`` too (stereo streams) and keeps nothing of the
+    frame structure: it is for benches that feed broken streams on purpose (the stream checker's).
+    ``sent_cycles`` counts cycles like :class:`BeatMonitor` (simulation time / clock period).
+    """
+
+    def __init__(self, dut, prefix: str, clk, idle: IdleGenerator | None = None, *, period_ns: float = 10):
+        self.cam = getattr(dut, f"{prefix}_cam", None)
+        self.period_ns = period_ns
+        if self.cam is not None:
+            self.cam.value = 0
+        super().__init__(dut, prefix, clk, idle)
+
+    async def _run(self):
+        from cocotb.utils import get_sim_time
+
+        while True:
+            await RisingEdge(self.clk)
+            if self.queue and self.idle():
+                beat = self.queue.popleft()
+                self.data.value = int(beat[0])
+                self.eol.value = int(bool(beat[1]))
+                self.eof.value = int(bool(beat[2]))
+                if self.cam is not None:
+                    self.cam.value = int(beat[3]) if len(beat) > 3 else 0
+                self.valid.value = 1
+                self.sent_cycles.append(round(get_sim_time(unit="ns") / self.period_ns))
+            else:
+                self.valid.value = 0
+
+
+class BeatMonitor:
+    """Records every valid beat of ``<prefix>_*`` as it is, without protocol checks, with extra outputs.
+
+    ``beats`` holds ``(cycle, data, eol, eof, cam, *extra)`` per valid beat (cycle = simulation time /
+    clock period, sampled just after the rising edge the beat was registered on; data ``UNKNOWN`` when
+    not 0/1; cam 0 for mono streams), ``extra`` the values of the named single ports on that beat.
+    ``changes[name]`` lists ``(cycle, value)`` of every change of an extra port, found by waiting for its
+    edges (no Python runs per clock for them).
+    """
+
+    def __init__(self, dut, prefix: str, clk, *, extra: tuple[str, ...] = (), period_ns: float = 10):
+        self.clk = clk
+        self.period_ns = period_ns
+        self.valid = getattr(dut, f"{prefix}_valid")
+        self.data = getattr(dut, f"{prefix}_data")
+        self.eol = getattr(dut, f"{prefix}_eol")
+        self.eof = getattr(dut, f"{prefix}_eof")
+        self.cam = getattr(dut, f"{prefix}_cam", None)
+        self.extra = {name: getattr(dut, name) for name in extra}
+        self.beats: list[tuple] = []
+        self.undefined: list[str] = []
+        self.changes: dict[str, list[tuple[int, int]]] = {name: [] for name in extra}
+        self.active = True
+        self._tasks = [cocotb.start_soon(self._run())]
+        self._tasks += [cocotb.start_soon(self._watch(n, s)) for n, s in self.extra.items()]
+
+    def _cycle(self) -> int:
+        from cocotb.utils import get_sim_time
+
+        return int(get_sim_time(unit="ns") // self.period_ns)
+
+    @staticmethod
+    def _int(v) -> int:
+        return int(v) if v.is_resolvable else UNKNOWN
+
+    async def _watch(self, name, sig):
+        while True:
+            await sig.value_change
+            await ReadOnly()
+            if self.active:
+                self.changes[name].append((self._cycle(), self._int(sig.value)))
+
+    async def _run(self):
+        while True:
+            await RisingEdge(self.clk)
+            await ReadOnly()
+            if not self.active:
+                continue
+            v = self.valid.value
+            if not v.is_resolvable:
+                self.undefined.append(f"cycle {self._cycle()}: valid is {v}")
+                continue
+            if not int(v):
+                continue
+            beat = [self._cycle(), self._int(self.data.value), self._int(self.eol.value), self._int(self.eof.value),
+                    self._int(self.cam.value) if self.cam is not None else 0]
+            beat += [self._int(s.value) for s in self.extra.values()]
+            if UNKNOWN in beat[1:]:
+                self.undefined.append(f"cycle {beat[0]}: beat {beat[1:]} has undefined bits")
+            self.beats.append(tuple(beat))

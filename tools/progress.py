@@ -1,10 +1,11 @@
-"""A tiny progress bar for the Rectification Toolbox (stderr, no dependency).
+"""Progress bars for the long toolbox steps: `tqdm`, drawn only where a person watches.
 
-It draws only when the stream is a terminal, or when forced (``force=True`` or the environment
+A bar is drawn on stderr when it is a terminal, or when forced (``force=True`` or the environment
 variable ``EYESTEREO_PROGRESS=1``); ``EYESTEREO_PROGRESS=0`` silences it everywhere. Redirected
-output, pytest's captured stderr and pipes therefore stay clean::
+output, pytest's captured stderr and pipes therefore stay clean, and a finished bar is erased
+(``leave=False``), so a command's own one-line result is what remains on the screen::
 
-    with Progress(len(pairs), "corners") as bar:
+    with progress_bar(len(pairs), "chessboard corners") as bar:
         for pair in pairs:
             ...
             bar.update()
@@ -14,10 +15,11 @@ from __future__ import annotations
 
 import os
 import sys
-import time
-from typing import IO
+from typing import IO, Any
 
-__all__ = ["Progress", "progress_enabled"]
+from tqdm import tqdm
+
+__all__ = ["progress_bar", "progress_enabled"]
 
 
 def progress_enabled(stream: IO[str] | None = None, force: bool | None = None) -> bool:
@@ -34,55 +36,11 @@ def progress_enabled(stream: IO[str] | None = None, force: bool | None = None) -
         return False
 
 
-class Progress:
-    """``[#####.....] label 5/10 1.2s`` on one line of ``stream``, redrawn at most every 0.1 s."""
-
-    def __init__(self, total: int, label: str = "", *, stream: IO[str] | None = None,
-                 force: bool | None = None, width: int = 30) -> None:
-        if total < 0:
-            raise ValueError(f"total must be >= 0, got {total}")
-        self.total = int(total)
-        self.label = label
-        self.stream = sys.stderr if stream is None else stream
-        self.enabled = progress_enabled(self.stream, force)
-        self.width = width
-        self.done = 0
-        self._t0 = time.monotonic()
-        self._last = -1.0
-        self._drawn = False
-
-    def __enter__(self) -> Progress:
-        self._draw(final=False)
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
-
-    def update(self, n: int = 1) -> None:
-        """Count ``n`` more steps done."""
-        self.done = min(self.total, self.done + n)
-        self._draw(final=False)
-
-    def close(self) -> None:
-        """Draw the final state and end the line (once)."""
-        if self.enabled and self._drawn:
-            self._draw(final=True)
-            self.stream.write("\n")
-            self.stream.flush()
-            self._drawn = False
-            self.enabled = False
-
-    def _draw(self, final: bool) -> None:
-        if not self.enabled:
-            return
-        now = time.monotonic()
-        if not final and self._drawn and now - self._last < 0.1 and self.done < self.total:
-            return
-        self._last = now
-        frac = 1.0 if self.total == 0 else self.done / self.total
-        filled = int(round(frac * self.width))
-        bar = "#" * filled + "." * (self.width - filled)
-        text = f"\r[{bar}] {self.label} {self.done}/{self.total} {now - self._t0:.1f}s"
-        self.stream.write(text)
-        self.stream.flush()
-        self._drawn = True
+def progress_bar(total: int, desc: str = "", *, force: bool | None = None, stream: IO[str] | None = None,
+                 **kw: Any) -> tqdm:
+    """A :class:`tqdm.tqdm` bar of ``total`` steps, disabled unless :func:`progress_enabled`."""
+    if total < 0:
+        raise ValueError(f"total must be >= 0, got {total}")
+    stream = sys.stderr if stream is None else stream
+    return tqdm(total=total, desc=desc, file=stream, disable=not progress_enabled(stream, force), leave=False,
+                dynamic_ncols=True, **kw)

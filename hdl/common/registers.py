@@ -2,6 +2,8 @@
 
 from myhdl import Signal, always, always_comb, always_seq, block, intbv
 
+from eyestereo.hdl.common.checks import check_int
+
 
 def like_signal(sig):
     """A fresh Signal with the same width and signedness as ``sig`` (value 0)."""
@@ -33,8 +35,7 @@ def dreg(clk, d, q):
 @block
 def delay(clk, din, dout, *, clocks: int):
     """``dout`` = ``din`` delayed by ``clocks`` (>= 1) free-running registers (no reset, no enable)."""
-    if clocks < 1:
-        raise ValueError(f"delay needs clocks >= 1, got {clocks}")
+    clocks = check_int("clocks", clocks, 1)
     stages = [like_signal(din) for _ in range(clocks - 1)] + [dout]
     insts = []
     src = din
@@ -70,8 +71,7 @@ def dreg_rst(clk, rst, d, q):
 @block
 def delay_rst(clk, rst, din, dout, *, clocks: int):
     """Like :func:`delay` for 1-bit control, with a synchronous reset so no stale flag survives ``rst``."""
-    if clocks < 1:
-        raise ValueError(f"delay_rst needs clocks >= 1, got {clocks}")
+    clocks = check_int("clocks", clocks, 1)
     stages = [Signal(bool(0)) for _ in range(clocks - 1)] + [dout]
     insts = []
     src = din

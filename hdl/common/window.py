@@ -18,6 +18,8 @@ These are helpers, not stream blocks: they are instantiated inside blocks such a
 
 from myhdl import Signal, always_comb, always_seq, block, intbv
 
+from eyestereo.hdl.common.checks import (block_error, check_clock, check_frame, check_int, check_reset,
+                                         check_signal, check_stream)
 from eyestereo.hdl.common.registers import assign, delay, delay_rst
 from eyestereo.hdl.line_delay import line_delay
 from eyestereo.hdl.stream import ImageStream
@@ -29,11 +31,19 @@ def column_taps(clk, rst, sink, taps, tap_valid, *, width: int, height: int):
 
     ``taps[-1]`` is the newest pixel (the sink's), ``taps[0]`` the one N-1 lines earlier. The taps and
     ``tap_valid`` (a pixel beat, not a reset token) are registered N-1 clocks after the sink beat.
+    ``sink`` must be a mono stream (a stereo one would mix the cameras in the window).
     """
+    check_clock(clk)
+    check_reset(rst)
+    check_stream("sink", sink)
+    dw = sink.data_width
+    if not isinstance(taps, (list, tuple)) or len(taps) < 2:
+        raise block_error(f"taps must be a list of at least 2 Signals, got {taps!r}"[:120])
+    for i, t in enumerate(taps):
+        check_signal(f"taps[{i}]", t, width=dw)
+    check_signal("tap_valid", tap_valid, width=1)
+    width, height = check_frame(width, height)
     n = len(taps)
-    if n < 2:
-        raise ValueError("column_taps needs at least 2 taps")
-    dw = len(sink.data)
     insts = []
     streams = [sink]
     for _ in range(n - 1):
@@ -70,11 +80,16 @@ def window_control(clk, rst, sink, source, *, width: int, height: int, radius: i
     Why no collision: a frame's own first output needs ``r * width + r + 1`` of its pixels, so it comes
     after the previous frame's self-emitted tail even when frames arrive back to back.
     """
+    check_clock(clk)
+    check_reset(rst)
+    check_stream("sink", sink)
+    check_stream("source", source)
+    width, height = check_frame(width, height)
+    radius = check_int("radius", radius, 0)
+    latency = check_int("latency", latency, 1)
     lead = radius * width + radius
     if lead >= width * height:
-        raise ValueError(f"a {2 * radius + 1}x{2 * radius + 1} window needs a frame larger than {width}x{height}")
-    if latency < 1:
-        raise ValueError("window_control latency must be >= 1")
+        raise block_error(f"a {2 * radius + 1}x{2 * radius + 1} window needs a frame larger than {width}x{height}")
     skip = Signal(intbv(lead, min=0, max=lead + 1))
     tail = Signal(intbv(0, min=0, max=lead + 1))
     ox = Signal(intbv(0, min=0, max=width))

@@ -1,12 +1,14 @@
-"""The ``eyestereo`` command line (tools/cli.py): end to end on real data, and every kind of bad input."""
+"""The ``eyestereo`` command line (tools/cli/): end to end on real data, bad command lines, groups, progress.
+
+The shared data is found at ``../shared`` beside the repository or where ``EYESTEREO_SHARED`` points."""
 
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 import sys
-import types
 from pathlib import Path
 
 import cv2
@@ -18,7 +20,8 @@ from eyestereo.tools.cli import main as cli
 from eyestereo.tools.rectify import maps as X
 from eyestereo.tools.rectify import rig as G
 
-DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "opencv_stereo_calib"
+SHARED = Path(os.environ.get("EYESTEREO_SHARED", Path(__file__).resolve().parents[2].parent / "shared"))
+DATA = SHARED / "data" / "opencv_stereo_calib"
 needs_data = pytest.mark.skipif(not DATA.is_dir(), reason=f"shared calibration images not found at {DATA}")
 
 
@@ -124,7 +127,7 @@ def inputs(tmp_path):
     cv2.imwrite(str(tmp_path / "small.png"), np.zeros((30, 40), np.uint8))
     cv2.imwrite(str(tmp_path / "cam.png"), np.zeros((288, 352), np.uint8))
     cv2.imwrite(str(tmp_path / "blank_l1.png"), np.full((288, 352), 128, np.uint8))
-    cv2.imwrite(str(tmp_path / "blank_r1.png"), np.full((288, 352), 128, np.uint8))
+    cv2.imwrite(str(tmp_path / "blank_r1.png"), np.full((288, 352), 120, np.uint8))
     (tmp_path / "notimage.png").write_text("hello")
     return tmp_path
 
@@ -159,8 +162,10 @@ BAD = {
     "corrupt maps": (["fit", "{d}/corrupt.npz", "-o", "{d}/out.json"], 1, "corrupt.npz"),
     "maps are yaml": (["fit", "{d}/calib.yml", "-o", "{d}/out.json"], 1, "calib.yml"),
     "bad degree": (["fit", "{d}/maps.npz", "--degree", "5", "-o", "{d}/out.json"], 2, "invalid choice"),
-    "plots folder missing": (["fit", "{d}/maps.npz", "--plots", "{d}/noplots", "-o", "{d}/out.json"], 1,
+    "plots parent missing": (["fit", "{d}/maps.npz", "--plots", "{d}/noplots/sub", "-o", "{d}/out.json"], 1,
                              "does not exist"),
+    "plots into a used folder": (["fit", "{d}/maps.npz", "--plots", "{d}", "-o", "{d}/out.json"], 1,
+                                 "which this command does not write"),
     "wrong image size": (["warp", "{d}/small.png", "{d}/maps.npz", "--side", "left", "-o", "{d}/out.png"], 1,
                          "image is 40x30 but the maps were made for 352x288"),
     "missing image": (["warp", "{d}/none.png", "{d}/maps.npz", "--side", "left", "-o", "{d}/out.png"], 1,
@@ -174,7 +179,7 @@ BAD = {
                              "corrupt.npz"),
     "bad side": (["warp", "{d}/cam.png", "{d}/maps.npz", "--side", "up", "-o", "{d}/out.png"], 2, "invalid choice"),
     "bad output type": (["warp", "{d}/cam.png", "{d}/maps.npz", "--side", "left", "-o", "{d}/out.xyz"], 1,
-                        "cannot write an image"),
+                        "cannot write an image of type '.xyz'"),
     "bad lut bits": (["lut", "{d}/maps.npz", "--frac-bits", "20", "-o", "{d}/out.h"], 2, "invalid choice"),
     "bad views": (["rig", "--views", "0", "-o", "{d}/out"], 2, "must be 1..99"),
     "rig onto a file": (["rig", "-o", "{d}/calib.yml"], 1, "not a folder"),
@@ -184,7 +189,7 @@ BAD = {
     "rectifier corrupt calib": (["rectifier", "{d}/corrupt.yml", "-o", "{d}/out"], 1, "corrupt.yml"),
     "rectifier calib without key": (["rectifier", "{d}/nokey.yml", "-o", "{d}/out"], 1, "key 'rms' is missing"),
     "rectifier onto a file": (["rectifier", "{d}/calib.yml", "-o", "{d}/calib.yml"], 1, "not a folder"),
-    "rectifier onto a used folder": (["rectifier", "{d}/calib.yml", "-o", "{d}"], 1, "did not write"),
+    "rectifier onto a used folder": (["rectifier", "{d}/calib.yml", "-o", "{d}"], 1, "does not write"),
     "rectifier bad degree": (["rectifier", "{d}/calib.yml", "--degree", "1", "-o", "{d}/out"], 2, "invalid choice"),
     "rectifier bad high": (["rectifier", "{d}/calib.yml", "--high", "x", "-o", "{d}/out"], 2, "not an integer"),
     "rectifier bad measure": (["rectifier", "{d}/calib.yml", "--measure", "rms", "-o", "{d}/out"], 2,
@@ -223,24 +228,38 @@ def test_console_script_reports_errors_in_one_line(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
-def test_part_b_subcommands_are_registered_when_present(monkeypatch, capsys):
-    fake = types.ModuleType("eyestereo.tools.cli.ffc")
+class FakeEntryPoint:
+    def __init__(self, name, register):
+        self.name, self._register = name, register
+
+    def load(self):
+        if isinstance(self._register, Exception):
+            raise self._register
+        return self._register
+
+
+def test_groups_from_entry_points_are_registered(monkeypatch, capsys):
+    """A layer above tools (the sim commands) adds its group through the "eyestereo.cli" entry points."""
     seen = {}
 
     def register(subparsers):
-        p = subparsers.add_parser("fakeffc", help="test")
-        p.set_defaults(func=lambda args: seen.setdefault("ran", 0) or 0)
+        p = subparsers.add_parser("fakesim", help="test")
+        p.add_argument("--n", type=int, default=1)
+        p.set_defaults(func=lambda args: seen.setdefault("ran", args.n) and 0)
         seen["registered"] = True
 
-    fake.register = register
-    monkeypatch.setitem(sys.modules, "eyestereo.tools.cli.ffc", fake)
-    import eyestereo.tools.cli as pkg
-    monkeypatch.setattr(pkg, "ffc", fake, raising=False)
-    code, _, err = run(capsys, "fakeffc")
-    assert code == 0 and seen == {"registered": True, "ran": 0}, err
-    # errors of part B's parsers are one line too
-    code, _, err = run(capsys, "fakeffc", "--nope")
+    monkeypatch.setattr(cli, "_extension_groups", lambda: [FakeEntryPoint("fakesim", register),
+                                                           FakeEntryPoint("broken", ImportError("no myhdl"))])
+    code, _, err = run(capsys, "fakesim", "--n", "4")
+    assert code == 0 and seen == {"registered": True, "ran": 4}, err
+    # errors of an extension's parser are one line too
+    code, _, err = run(capsys, "fakesim", "--nope")
     assert code == 2 and err.startswith("eyestereo: error: ") and err.count("\n") == 1
+    # a group that cannot load breaks nothing else, and says why when it is used
+    code, out, _ = run(capsys, "--help")
+    assert code == 0 and "fakesim" in out and "broken" in out
+    code, _, err = run(capsys, "broken", "x")
+    assert code == 1 and err.count("\n") == 1 and "cannot be loaded (ImportError: no myhdl)" in err
 
 
 def test_every_subcommand_is_registered(capsys):
@@ -265,7 +284,7 @@ def test_lut_from_poly_json(tmp_path, capsys):
 
 
 # --------------------------------------------------------------------------------------------------
-# The progress bar
+# The progress bar (tqdm)
 
 
 class FakeTTY:
@@ -283,25 +302,24 @@ class FakeTTY:
 
 
 def test_progress_draws_only_on_a_terminal_or_when_forced(monkeypatch):
-    from eyestereo.tools.progress import Progress
+    from eyestereo.tools.progress import progress_bar
 
     monkeypatch.delenv("EYESTEREO_PROGRESS", raising=False)
     for tty, force, drawn in ((True, None, True), (False, None, False), (False, True, True), (True, False, False)):
         s = FakeTTY(tty)
-        with Progress(3, "work", stream=s, force=force) as bar:
+        with progress_bar(3, "work", stream=s, force=force) as bar:
             for _ in range(3):
                 bar.update()
         assert bool(s.text) == drawn, (tty, force)
-        if drawn:
-            assert s.text.endswith("] work 3/3 " + s.text.rsplit(" ", 1)[-1]) and s.text.endswith("s\n")
-            assert "#" * 30 in s.text and s.text.count("\n") == 1
+        if drawn:  # tqdm's bar, erased when done (leave=False): the command's result line stays alone
+            assert "work:" in s.text and "/3 [" in s.text and s.text.endswith("\r")
     monkeypatch.setenv("EYESTEREO_PROGRESS", "0")
     s = FakeTTY(True)
-    with Progress(2, "x", stream=s) as bar:
+    with progress_bar(2, "x", stream=s) as bar:
         bar.update(2)
     assert s.text == ""
     with pytest.raises(ValueError):
-        Progress(-1)
+        progress_bar(-1)
 
 
 def test_cli_stderr_stays_clean_when_not_a_terminal(tmp_path, capsys):

@@ -1,7 +1,9 @@
-"""``eyestereo evaluate`` / ``eyestereo sweep`` (tools/cli_eval.py): end to end and every kind of bad input."""
+"""``eyestereo evaluate`` / ``eyestereo sweep`` (tools/cli/matching.py, tools/matching/evaluate.py): end to end and
+every kind of bad input; the ground truth scores only."""
 
 from __future__ import annotations
 
+import os
 import argparse
 import json
 from pathlib import Path
@@ -11,15 +13,17 @@ import numpy as np
 import pytest
 
 import eyestereo.tools
+from eyestereo.tools.cli import main as cli
 from eyestereo.tools.cli import matching as E
+from eyestereo.tools.matching import evaluate as V
 
-DATA = Path(eyestereo.tools.__file__).resolve().parents[1].parent / "shared" / "data" / "middlebury"
+DATA = Path(os.environ.get("EYESTEREO_SHARED", Path(eyestereo.tools.__file__).resolve().parents[1].parent / "shared")) / "data" / "middlebury"
 needs_middlebury = pytest.mark.skipif(not (DATA / "tsukuba" / "im3.png").is_file(),
                                       reason=f"Middlebury images not found at {DATA}")
 
 
 def run(capsys, *argv) -> tuple[int, str, str]:
-    code = E.main([str(a) for a in argv])
+    code = cli.main([str(a) for a in argv])
     out, err = capsys.readouterr()
     return code, out, err
 
@@ -56,7 +60,8 @@ def test_evaluate_synthetic_pair_is_perfect(synthetic, capsys):
     assert {"matches", "good", "bad", "bad_percent", "rms", "seconds"} <= set(doc)
     assert doc["bad"] == 0 and doc["rms"] == 0.0 and doc["bad_percent"] == 0.0
     assert doc["good"] == doc["evaluated"] > 50 and doc["matches"] == doc["evaluated"] + doc["unknown"]
-    assert doc["params"]["d_max"] == 7                    # ceil(max GT) + 1
+    assert doc["params"]["d_max"] == 96 // 4              # from the image width, not from the ground truth
+    assert doc["params"]["cost"] == "ncc" and doc["params"]["lr_check"] is True
     assert 0 < doc["seconds"] < 1 and "bad 0.00 %" in out
 
 
@@ -71,7 +76,8 @@ def test_evaluate_tsukuba_end_to_end(tmp_path, capsys):
     assert doc["good"] + doc["bad"] == doc["evaluated"] and doc["matches"] >= doc["evaluated"] > 200
     assert doc["bad_percent"] == pytest.approx(100 * doc["bad"] / doc["evaluated"], abs=1e-4)
     assert doc["bad_percent"] < 10 and doc["rms"] < 1.5
-    assert doc["params"]["d_max"] == 15 and doc["params"]["window"] == [9, 9] and doc["params"]["t_max"] == 11
+    assert doc["params"]["d_max"] == 384 // 4 and doc["params"]["window"] == [11, 11]
+    assert doc["params"]["ncc_min"] == 0.75 and doc["good"] >= 150
     assert doc["dense"]["evaluated"] > 80000 and doc["dense"]["bad_percent"] > doc["bad_percent"]
     for name in ("matches.png", "disparity.png", "dense.png"):
         img = cv2.imread(str(o / name))
@@ -83,7 +89,7 @@ def test_sweep_t_max_is_monotone(synthetic, capsys):
     j, p = synthetic / "sweep.json", synthetic / "sweep.png"
     code, out, err = run(capsys, "sweep", synthetic / "L.png", synthetic / "R.png", synthetic / "gt.pgm",
                          "--scale", 4, "--vary", "t_max", "--values", "0.5:3:0.5", "--json", j, "--plot", p,
-                         "--corners", 150)
+                         "--corners", 150, "--cost", "sad", "--no-lr-check")
     assert code == 0, err
     rows = json.loads(j.read_text())["rows"]
     assert [r["value"] for r in rows] == [0.5, 1.0, 1.5, 2.0, 2.5, 3.0]
@@ -100,9 +106,28 @@ def test_register_adds_both_commands():
     parser = argparse.ArgumentParser(prog="eyestereo")
     E.register(parser.add_subparsers(dest="command", required=True))
     a = parser.parse_args(["evaluate", "l.png", "r.png", "gt.pgm", "--scale", "16", "--json", "x.json"])
-    assert a.func is E.cmd_evaluate and a.scale == 16 and a.window == (9, 9) and a.t_max == 11
-    b = parser.parse_args(["sweep", "l", "r", "g", "--vary", "split", "--values", "1,9", "--window", "5x7"])
-    assert b.func is E.cmd_sweep and b.window == (5, 7)
+    assert a.func is E.cmd_evaluate and a.scale == 16 and a.window == (11, 11) and a.t_max == 11
+    assert a.cost == "ncc" and a.ncc_min == 0.75 and a.lr_check is True and a.max_disparity is None
+    b = parser.parse_args(["sweep", "l", "r", "g", "--vary", "split", "--values", "1,9", "--window", "5x7",
+                           "--no-lr-check"])
+    assert b.func is E.cmd_sweep and b.window == (5, 7) and b.lr_check is False
+
+
+def test_the_ground_truth_does_not_change_the_matches(synthetic, tmp_path, capsys):
+    """Scoring against a different ground truth gives the same matches: nothing is read from it."""
+    import cv2 as _cv2
+
+    other = tmp_path / "gt_other.pgm"
+    _cv2.imwrite(str(other), np.full((64, 96), 200, np.uint8))   # disparity 50: all wrong, and a larger range
+    docs = []
+    for gt in (synthetic / "gt.pgm", other):
+        j = tmp_path / f"{gt.stem}.json"
+        code, out, err = run(capsys, "evaluate", synthetic / "L.png", synthetic / "R.png", gt, "--scale", 4,
+                             "--json", j, "--corners", 150)
+        assert code == 0, err
+        docs.append(json.loads(j.read_text()))
+    assert docs[0]["params"] == docs[1]["params"] and docs[0]["matches"] == docs[1]["matches"]
+    assert docs[0]["bad"] == 0 and docs[1]["good"] == 0
 
 
 def one_error_line(err: str) -> str:
@@ -125,6 +150,7 @@ def test_runtime_errors_exit_1_and_write_nothing(synthetic, capsys):
         ((L, synthetic / "none.png", G), "does not exist"),
         ((L, R, G, "--threshold", 524287), "no corners"),
         ((L, R, G, "--json", synthetic / "no" / "x.json"), "does not exist"),
+        ((L, R, G, "--cost", "ncc", "--split", "9"), "split correlation is defined for the SAD and SSD costs only"),
     ]
     for args, msg in cases:
         code, out, err = run(capsys, "evaluate", *args, "--json", j) if "--json" not in args else \
@@ -133,7 +159,7 @@ def test_runtime_errors_exit_1_and_write_nothing(synthetic, capsys):
         assert msg in one_error_line(err)
     (synthetic / "junk.png").write_bytes(b"garbage")
     code, out, err = run(capsys, "evaluate", L, synthetic / "junk.png", G, "--json", j, "-o", synthetic / "o")
-    assert code == 1 and "cannot read" in one_error_line(err)
+    assert code == 1 and "cannot read right image" in one_error_line(err) and "junk.png" in err
     assert only_inputs(synthetic) == sorted(before + ["junk.png"])
 
 
@@ -150,11 +176,12 @@ def test_usage_errors_exit_2(synthetic, capsys):
 
 
 def test_parse_values():
-    assert E.parse_values("t_max", "9:13:2") == [9.0, 11.0, 13.0]
-    assert E.parse_values("window", "5x7, 9") == [(5, 7), (9, 9)]
-    assert E.parse_values("split", "1,5,9") == [1, 5, 9]
-    assert E.parse_values("rows", "0:2") == [0, 1, 2]
+    assert V.parse_values("ncc_min", "0.7:0.8:0.05") == [0.7, 0.75, 0.8]
+    assert V.parse_values("t_max", "9:13:2") == [9.0, 11.0, 13.0]
+    assert V.parse_values("window", "5x7, 9") == [(5, 7), (9, 9)]
+    assert V.parse_values("split", "1,5,9") == [1, 5, 9]
+    assert V.parse_values("rows", "0:2") == [0, 1, 2]
     with pytest.raises(ValueError, match="split"):
-        E.parse_values("split", "3")
+        V.parse_values("split", "3")
     with pytest.raises(ValueError, match="positive step"):
-        E.parse_values("t_max", "5:1")
+        V.parse_values("t_max", "5:1")

@@ -1,7 +1,13 @@
-"""Architecture rule: tools imports neither myhdl nor cocotb (nor hdl/sim); hdl never imports sim or cocotb.
+"""Architecture rules.
 
-Checked twice: statically, by parsing every module with ``ast`` (also catches imports inside functions),
-and dynamically, by importing each tools module in a fresh interpreter and looking at ``sys.modules``.
+* Layers: tools imports neither myhdl nor cocotb (nor hdl/sim); hdl never imports sim or cocotb. Checked
+  twice: statically, by parsing every module with ``ast`` (also catches imports inside functions), and
+  dynamically, by importing each tools module in a fresh interpreter and looking at ``sys.modules``.
+* Sub-packages of tools (:data:`ALLOWED`): the core modules (fixed, packed, stream, testpattern, io,
+  progress) import no sub-package; models import only the core; rectify the core; matching the core and
+  the models; cli everything but the reports; the reports everything.
+* No internals across modules: no module of tools imports a ``_private`` name from another module or
+  reaches into one through ``module._name``.
 """
 
 from __future__ import annotations
@@ -123,6 +129,95 @@ def test_tools_module_imports_no_hdl_or_simulator(path):
 @pytest.mark.parametrize("path", py_files("hdl"), ids=lambda p: f"hdl/{p.relative_to(ROOT / 'hdl')}")
 def test_hdl_module_imports_no_sim_or_cocotb(path):
     assert violations("hdl", path) == []
+
+
+# --------------------------------------------------------------------------------------------------
+# Sub-packages of tools
+
+CORE = "core"
+#: What each part of tools may import from tools (``core`` = the top-level modules of eyestereo.tools).
+ALLOWED = {
+    CORE: {CORE},
+    "models": {CORE, "models"},
+    "rectify": {CORE, "rectify"},
+    "matching": {CORE, "models", "matching"},
+    "cli": {CORE, "models", "rectify", "matching", "cli"},
+    "reports": {CORE, "models", "rectify", "matching", "cli", "reports"},
+}
+
+
+def tools_part(module: str) -> str | None:
+    """The part of tools a module belongs to (a sub-package name or CORE), None outside tools."""
+    if module == "eyestereo.tools":
+        return CORE
+    if not module.startswith("eyestereo.tools."):
+        return None
+    head = module.split(".")[2]
+    return head if head in ALLOWED and head != CORE else CORE
+
+
+def part_violations(path: Path) -> list[str]:
+    mod = module_name("tools", path)
+    package = mod if path.name == "__init__.py" else mod.rsplit(".", 1)[0]
+    own = tools_part(mod)
+    out = []
+    for line, imp in imported_modules(path, package):
+        other = tools_part(imp)
+        if other is not None and other not in ALLOWED[own]:
+            out.append(f"{path.relative_to(ROOT)}:{line} ({own}) imports {imp} ({other})")
+    return out
+
+
+def private_uses(path: Path, package: str) -> list[str]:
+    """``from eyestereo.x import _name`` and ``alias._name`` (alias an imported eyestereo module) in a file."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    aliases = set()
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            aliases |= {a.asname or a.name for a in node.names if a.name.startswith("eyestereo.")}
+        elif isinstance(node, ast.ImportFrom):
+            mod = node.module or ""
+            if node.level:
+                parts = package.split(".")
+                mod = ".".join(parts[: len(parts) - (node.level - 1)] + ([node.module] if node.module else []))
+            if mod.startswith("eyestereo"):
+                for a in node.names:
+                    if a.name.startswith("_") and not a.name.startswith("__"):
+                        out.append(f"{path.name}:{node.lineno} imports {mod}.{a.name}")
+                    else:
+                        aliases.add(a.asname or a.name)
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute) and node.attr.startswith("_") and not node.attr.startswith("__"):
+            base = node.value
+            if isinstance(base, ast.Name) and base.id in aliases:
+                out.append(f"{path.name}:{node.lineno} uses {base.id}.{node.attr}")
+    return out
+
+
+def test_part_checker_and_private_checker_can_fail(tmp_path):
+    assert tools_part("eyestereo.tools.models.sobel") == "models" and tools_part("eyestereo.tools.io") == CORE
+    assert tools_part("eyestereo.hdl.sobel") is None
+    bad = tmp_path / "bad.py"
+    bad.write_text("from eyestereo.tools.cli.main import _positive\n"
+                   "from eyestereo.tools.rectify import calib as C\n"
+                   "import eyestereo.tools.fixed\n"
+                   "x = C._load_gray\n"
+                   "y = eyestereo.tools.fixed._x\n")
+    found = private_uses(bad, "eyestereo.tools.reports")
+    assert len(found) == 2 and "_positive" in found[0] and "C._load_gray" in found[1]
+
+
+@pytest.mark.parametrize("path", py_files("tools"), ids=lambda p: f"tools/{p.relative_to(ROOT / 'tools')}")
+def test_tools_part_imports_only_what_its_layer_allows(path):
+    assert part_violations(path) == []
+
+
+@pytest.mark.parametrize("path", py_files("tools"), ids=lambda p: f"tools/{p.relative_to(ROOT / 'tools')}")
+def test_no_private_names_across_modules(path):
+    mod = module_name("tools", path)
+    package = mod if path.name == "__init__.py" else mod.rsplit(".", 1)[0]
+    assert private_uses(path, package) == []
 
 
 # --------------------------------------------------------------------------------------------------

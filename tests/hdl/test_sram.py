@@ -163,5 +163,6 @@ def test_subsystem_no_starvation_under_overload(request, kind):
     assert rep["measured"]["total_per_clock"] > 0.85          # the bus is full
     assert m["cam0"] > 0.19 and m["cam1"] > 0.19               # cameras at their rate
     assert m["rect"] > 0.25                                    # the stream's 0.3 words/clock, nothing lost
-    assert m["fetch"] > 0.05 and m["feat"] > 0.02 and m["host"] > 0.02
+    # the round robin is by turns (fetch and features 8 words a turn, the host 1): every one keeps moving
+    assert m["fetch"] > 0.05 and m["feat"] > 0.05 and m["host"] > 0.01
     assert max(rep["host_latency"]) < 200, max(rep["host_latency"])

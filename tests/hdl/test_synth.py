@@ -1,8 +1,8 @@
-"""Yosys synthesis for the Spartan-3E: the line delay maps to block RAM, Sobel uses no multiplier."""
+"""Synthesis from GHDL's netlist: the line delay maps to block RAM, Sobel uses no multiplier, fmax from nextpnr."""
 
 import pytest
 
-from eyestereo.hdl.synth import parse_stat, summarize, synth_block, table
+from eyestereo.hdl.synth import parse_fmax, parse_stat, summarize, synth_block, table, write_doc_section
 
 pytestmark = pytest.mark.synth
 
@@ -53,3 +53,35 @@ def test_sobel_resources(tmp_path):
     assert s["RAMB16"] == 2 and s["LUTRAM"] == 0
     assert s["LUT"] <= 259  # thesis Table 6.1: 259 LUTs for the separable Sobel
     assert "| sobel |" in table([r])
+
+
+def test_line_delay_whole_flow_gives_fmax(tmp_path):
+    """The smallest block through every step: VHDL -> GHDL netlist -> Yosys (xc3se, ecp5) -> nextpnr."""
+    r = synth_block("line_delay", tmp_path, pnr=True)
+    assert r["summary"]["RAMB16"] == 1, r["cells"]
+    assert set(r["fmax"]) == {"clk"}, r["fmax"]
+    f = r["fmax"]["clk"]
+    assert f["constraint"] == 100.0 and 50.0 < f["achieved"] < 1000.0, f
+    assert r["ecp5"]["DP16KD"] == 1 and r["ecp5"]["TRELLIS_FF"] > 0, r["ecp5"]
+    assert r["clocks"] == {"clk": 50.0}
+    assert (tmp_path / "line_delay" / "line_delay_netlist.v").exists()
+    md = table([r])
+    assert "| line_delay |" in md and "fmax ECP5" in md
+
+
+def test_parse_fmax_names_clock_ports():
+    rep = {"fmax": {"$glbnet$clk$TRELLIS_IO_IN": {"achieved": 83.4, "constraint": 100},
+                    "$glbnet$wr_clk$TRELLIS_IO_IN": {"achieved": 201.0, "constraint": 100}}}
+    f = parse_fmax(rep, ["clk", "wr_clk"])
+    assert f["clk"]["achieved"] == 83.4 and f["wr_clk"]["achieved"] == 201.0
+
+
+def test_doc_section_replaced_in_place(tmp_path):
+    doc = tmp_path / "b.md"
+    doc.write_text("# B\n\nbefore\n\n<!-- synth:begin -->\nold\n<!-- synth:end -->\n\nafter\n")
+    write_doc_section(doc, "new table\n")
+    assert doc.read_text() == "# B\n\nbefore\n\n<!-- synth:begin -->\nnew table\n<!-- synth:end -->\n\nafter\n"
+    other = tmp_path / "c.md"
+    other.write_text("# C\n")
+    write_doc_section(other, "t\n")
+    assert other.read_text() == "# C\n\n<!-- synth:begin -->\nt\n<!-- synth:end -->\n"

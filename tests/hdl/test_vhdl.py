@@ -3,6 +3,9 @@
 import json
 import re
 import shutil
+import subprocess
+import sys
+from pathlib import Path
 
 import pytest
 from myhdl import ResetSignal, Signal
@@ -19,26 +22,33 @@ needs_ghdl = pytest.mark.skipif(shutil.which("ghdl") is None, reason="GHDL not i
 def test_make_vhdl_writes_and_analyses_every_block(tmp_path):
     m = make_vhdl(tmp_path)  # raises if GHDL rejects anything
     files = sorted(p.name for p in tmp_path.iterdir())
-    assert len([f for f in files if f.startswith("pck_myhdl_")]) == 1
+    assert len([f for f in files if f.startswith("pck_myhdl_") and f.endswith(".vhd")]) == 1
     assert {b["entity"] for b in m["blocks"]} == set(BLOCKS)
     manifest = json.loads((tmp_path / "manifest.json").read_text())
     assert manifest == json.loads(json.dumps(m))
     for b in manifest["blocks"]:
         assert (tmp_path / f"{b['entity']}.vhd").exists()
-        names = [p["name"] for p in b["ports"]]
-        if BLOCKS[b["entity"]].ports is not None:
-            # blocks with their own interfaces (e.g. the SRAM blocks): clock and reset first, all ports there
-            assert names[:2] == ["clk", "rst"] and len(names) > 2
-            assert b["files"][0] == manifest["package"]
+        assert b["files"][0] == manifest["package"]
+        if BLOCKS[b["entity"]].build is not None:  # own port lists: tests/hdl/test_camera_params.py
             continue
-        control = [n for n, _ in BLOCKS[b["entity"]].control]
+        names = [p["name"] for p in b["ports"]]
+        spec = BLOCKS[b["entity"]]
+        control = [n for n, _ in spec.control]
+        _, ports, _ = spec.elaborate()
         # MyHDL lists plain signal ports (clk, rst, control) before the flattened stream interfaces.
-        assert names == ["clk", "rst"] + control + ["sink_data", "sink_valid", "sink_eol", "sink_eof",
-                                                     "source_data", "source_valid", "source_eol", "source_eof"]
+        assert names == ["clk", "rst"] + control + [f"sink_{f}" for f in ports["sink"].fields()] + \
+            [f"source_{f}" for f in ports["source"].fields()]
         dirs = {p["name"]: p["dir"] for p in b["ports"]}
-        assert dirs["sink_data"] == "in" and dirs["source_data"] == "out"
+        assert dirs[f"sink_{ports['sink'].fields()[0]}"] == "in"
+        assert dirs[f"source_{ports['source'].fields()[0]}"] == "out"
         assert b["files"][0] == manifest["package"]
         assert b["parameters"]["width"] == 352 and b["parameters"]["height"] == 288
+    assert sorted(manifest["cores"]) == sorted([f"{b}.core" for b in BLOCKS] + ["pck_myhdl_011.core"])
+    fusesoc = Path(sys.executable).parent / "fusesoc"
+    if fusesoc.exists():  # FuseSoC accepts every generated core (tests/hdl/test_fusesoc.py runs one)
+        r = subprocess.run([str(fusesoc), "--cores-root", str(tmp_path), "core", "list"], capture_output=True,
+                           text=True, cwd=tmp_path)
+        assert r.returncode == 0 and all(f"eyestereo:blocks:{b}:" in r.stdout for b in BLOCKS), r.stdout + r.stderr
     sobel = next(b for b in manifest["blocks"] if b["entity"] == "sobel")
     widths = {p["name"]: p["type"] for p in sobel["ports"]}
     assert widths["sink_data"] == "unsigned(7 downto 0)"

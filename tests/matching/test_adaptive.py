@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -11,7 +12,7 @@ import eyestereo.tools
 from eyestereo.tools.matching import adaptive as A
 from eyestereo.tools.models import harris_mono as hm
 
-DATA = Path(eyestereo.tools.__file__).resolve().parents[1].parent / "shared" / "data" / "middlebury"
+DATA = Path(os.environ.get("EYESTEREO_SHARED", Path(eyestereo.tools.__file__).resolve().parents[1].parent / "shared")) / "data" / "middlebury"
 needs_middlebury = pytest.mark.skipif(not (DATA / "tsukuba" / "im3.png").is_file(),
                                       reason=f"Middlebury images not found at {DATA}")
 

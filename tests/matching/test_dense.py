@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import time
 from pathlib import Path
 
@@ -13,7 +14,7 @@ from eyestereo.tools.matching import dense as D
 from eyestereo.tools.matching import sparse as M
 from eyestereo.tools.matching import metrics as Q
 
-DATA = Path(eyestereo.tools.__file__).resolve().parents[1].parent / "shared" / "data" / "middlebury"
+DATA = Path(os.environ.get("EYESTEREO_SHARED", Path(eyestereo.tools.__file__).resolve().parents[1].parent / "shared")) / "data" / "middlebury"
 needs_middlebury = pytest.mark.skipif(not (DATA / "tsukuba" / "im3.png").is_file(),
                                       reason=f"Middlebury images not found at {DATA}")
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import math
 from pathlib import Path
 
@@ -12,7 +13,7 @@ import pytest
 import eyestereo.tools
 from eyestereo.tools.matching import metrics as Q
 
-DATA = Path(eyestereo.tools.__file__).resolve().parents[1].parent / "shared" / "data" / "middlebury"
+DATA = Path(os.environ.get("EYESTEREO_SHARED", Path(eyestereo.tools.__file__).resolve().parents[1].parent / "shared")) / "data" / "middlebury"
 needs_middlebury = pytest.mark.skipif(not (DATA / "tsukuba" / "disp3.pgm").is_file(),
                                       reason=f"Middlebury ground truth not found at {DATA}")
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import json
 
 import numpy as np
@@ -229,7 +230,7 @@ def test_table_4_1_on_real_data_decreases_with_degree():
 
     from eyestereo.tools.rectify import calib as C
 
-    data = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "opencv_stereo_calib"
+    data = Path(os.environ.get("EYESTEREO_SHARED", Path(__file__).resolve().parents[2].parent / "shared")) / "data" / "opencv_stereo_calib"
     if not data.is_dir():
         pytest.skip(f"shared calibration images not found at {data}")
     cal = C.calibrate_stereo(str(data / "left*.jpg"), str(data / "right*.jpg"))

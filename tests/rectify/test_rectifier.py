@@ -23,7 +23,7 @@ from eyestereo.tools.cli import main as cli
 from eyestereo.tools.rectify import rig as G
 from eyestereo.tools.rectify.run import OUTPUT_FILES, PLOT_FILES, run_all
 
-DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "opencv_stereo_calib"
+DATA = Path(os.environ.get("EYESTEREO_SHARED", Path(__file__).resolve().parents[2].parent / "shared")) / "data" / "opencv_stereo_calib"
 MAP_KEYS = ("left_x", "left_y", "right_x", "right_y")
 # thesis eq. 4.1: p1..p10 multiply 1, x, y, x^2, y^2, xy, x^3, y^3, x^2y, xy^2
 EXPONENTS = [(0, 0), (1, 0), (0, 1), (2, 0), (0, 2), (1, 1), (3, 0), (0, 3), (2, 1), (1, 2)]
@@ -221,7 +221,7 @@ def test_progress_bar_when_asked(rig_run, tmp_path, capsys):
     calib, _, _ = rig_run
     run_all(calib, tmp_path / "o", degree=2, progress=True)
     err = capsys.readouterr().err
-    assert "rectifier: plots" in err and "] rectifier: report 5/5" in err
+    assert "rectifier: plots" in err and "rectifier: report" in err and "/5 [" in err  # tqdm, one step each
 
 
 # --------------------------------------------------------------------------------------------------

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 from pathlib import Path
@@ -16,7 +17,7 @@ from eyestereo.tools.rectify import warp as W
 from eyestereo.tools.rectify import maps as X
 from eyestereo.tools.rectify import rig as G
 
-DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "opencv_stereo_calib"
+DATA = Path(os.environ.get("EYESTEREO_SHARED", Path(__file__).resolve().parents[2].parent / "shared")) / "data" / "opencv_stereo_calib"
 
 
 @pytest.fixture(scope="module")

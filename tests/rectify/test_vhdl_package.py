@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from eyestereo.tools.cli import ffc as cli_ffc
+from eyestereo.tools.cli import main as cli_main
 from eyestereo.tools.rectify import ffc, vhdl_package
 from eyestereo.tools.reports.bench_ffc import synthetic_rig_polynomials
 from eyestereo.tools.fixed import Fmt
@@ -129,7 +130,9 @@ def test_package_from_result_equals_package_from_json(result, qjson, tmp_path):
 
 @needs_ghdl
 def test_package_wide_and_negative_codes(tmp_path):
-    """Codes beyond a 32-bit VHDL integer become bit strings; one polynomial; another name."""
+    """Codes beyond a 32-bit VHDL integer become bit strings; one polynomial; another name.
+
+    (A quantizers.json must hold the four polynomials; the package writer itself takes any set.)"""
     quants = [{"name": f"q{n}", "signed": n % 2 == 1, "wl": 12, "fl": 3} for n in range(1, 27)]
     quants[0] = {"name": "q1", "signed": True, "wl": 40, "fl": 10}
     quants[1] = {"name": "q2", "signed": False, "wl": 36, "fl": -2}
@@ -139,8 +142,10 @@ def test_package_wide_and_negative_codes(tmp_path):
            "polynomials": {"cam": {"codes": codes}}}
     path = tmp_path / "q.json"
     path.write_text(json.dumps(doc))
+    with pytest.raises(ffc.FFCError, match="must hold the four left_x, left_y, right_x, right_y; it lacks"):
+        vhdl_package.write_package(path, tmp_path / "x.vhd")
     out = tmp_path / "pkg.vhd"
-    text = vhdl_package.write_package(path, out, name="rig_b_pkg")
+    text = vhdl_package.write_package(doc, out, name="rig_b_pkg")
     fmts, back = parse_package(text)
     assert back == {"cam": codes}
     assert "signed'(\"1" + "0" * 39 + "\")" in text and "unsigned'(\"" + "1" * 36 + "\")" in text
@@ -154,7 +159,7 @@ def test_package_name_must_be_an_identifier(result, name):
 
 
 def run_cli(argv, capsys):
-    code = cli_ffc.main([str(a) for a in argv])
+    code = cli_main.main([str(a) for a in argv])
     out, err = capsys.readouterr()
     return code, out, err
 
@@ -167,7 +172,7 @@ def test_cli_package(qjson, tmp_path, capsys):
 
 
 @pytest.mark.parametrize("case, message", [
-    ("missing", "no such file"),
+    ("missing", "does not exist"),
     ("badjson", "not valid JSON"),
     ("count", "must list 26 formats"),
     ("order", "entry 3 must be named 'q3'"),
@@ -196,4 +201,4 @@ def test_cli_package_bad_input(qjson, tmp_path, capsys, case, message):
     assert code != 0
     assert err.startswith("eyestereo: error: ") and err.count("\n") == 1 and message in err
     assert not out.exists()
-    assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]

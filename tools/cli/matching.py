@@ -1,24 +1,23 @@
 """``eyestereo evaluate`` and ``eyestereo sweep``: sparse feature matching against ground truth (thesis 7.3).
 
-``eyestereo.tools.cli.main`` calls :func:`register` with its sub-parsers; :func:`main` runs the two commands
-on their own (``python -m eyestereo.tools.cli.matching evaluate L.png R.png GT.pgm --scale 16``)::
+::
 
     eyestereo evaluate LEFT RIGHT GT [--scale S] [--json FILE] [-o DIR] [--dense] [matching options]
-    eyestereo sweep LEFT RIGHT GT --vary t_max|window|split|cost|rows --values LIST [--scale S]
+    eyestereo sweep LEFT RIGHT GT --vary t_max|window|split|cost|rows|ncc_min --values LIST [--scale S]
                     [--json FILE] [--plot PNG] [matching options]
 
 GT is a disparity map of the left view: an 8/16-bit PGM/PNG holding disparity x ``--scale`` (Middlebury:
 16 for Tsukuba, 8 for Venus), 0 = unknown; or a PFM/.npy of float disparities (0, NaN, inf = unknown).
-Corners come from the bit-true Harris model with one threshold code for both images, chosen so that
-the left image gives about ``--corners`` corners (or given by ``--threshold``). The disparity range is
-0 .. ceil(max GT) + 1 unless ``--max-disparity`` says otherwise.
+The ground truth only scores the result: the matcher's parameters come from the command line or from
+the images (:mod:`eyestereo.tools.matching.evaluate`: corners from the bit-true Harris model with one
+threshold code for both images, about ``--corners`` in the left one; NCC 11x11 >= 0.75 with the
+left-right check; disparities 0 .. width / 4 unless ``--max-disparity`` says otherwise).
 
 ``evaluate`` prints the figures and, with ``--json``, writes ``matches``, ``good``, ``bad``,
 ``bad_percent``, ``rms``, ``seconds`` (the time of the matching step; ``seconds_features`` holds the
 corner detection's) and the details; with ``-o DIR`` it writes ``matches.png`` and ``disparity.png``
-(and ``dense.png`` with ``--dense``). Failures: one line ``eyestereo: error: ...`` on stderr, exit status 1
-(run time) or 2 (command line); every output is written to a temporary file and renamed into place once
-everything has been computed, so a failure leaves no partial output.
+(and ``dense.png`` with ``--dense``) into DIR. Outputs, errors and exit codes:
+:mod:`eyestereo.tools.cli.common` (all outputs are written together, only when everything is computed).
 """
 
 from __future__ import annotations
@@ -26,250 +25,26 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
-import re
-import sys
-import tempfile
 import time
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import Any
 
 import numpy as np
 
-from eyestereo.tools.matching import sparse as M
+from eyestereo.tools.cli.common import EXIT_USAGE, number, positive, print_error, window
+from eyestereo.tools.io import Outputs
 from eyestereo.tools.matching import metrics as Q
+from eyestereo.tools.matching import sparse as M
+from eyestereo.tools.matching.evaluate import DEFAULTS, VARY, evaluate_pair, parse_values, summary, sweep_pair
 
-__all__ = ["register", "main", "build_parser", "evaluate_pair", "sweep_pair", "default_d_max",
-           "parse_window", "parse_values"]
+__all__ = ["cmd_evaluate", "cmd_sweep", "register"]
 
-PROG = "eyestereo"
-VARY = ("t_max", "window", "split", "cost", "rows")
-
-
-# --------------------------------------------------------------------------------------------------
-# The computations (also used by tools/bench_matching.py)
-
-
-def default_d_max(gt: np.ndarray) -> int:
-    """ceil(max ground truth) + 1 (the +1 leaves room for sub-pixel ground truth and rounding)."""
-    g = np.asarray(gt, np.float64)
-    if not np.any(np.isfinite(g)):
-        raise ValueError("the ground truth holds no known disparity")
-    return int(math.ceil(float(np.nanmax(g)))) + 1
-
-
-def evaluate_pair(left, right, gt, *, corners: int = 500, threshold: int | None = None, k: float = 0.04,
-                  nms: int = 3, d_max: int | None = None, left_xy=None, right_xy=None,
-                  **match_kw) -> dict:
-    """Corners (unless given), matching and scores of one stereo pair; a dict with the figures and the
-    objects (``result["matches"]`` is a :class:`~eyestereo.tools.matching.sparse.Matches`)."""
-    left, right = M.check_pair(left, right)
-    gt = Q.check_gt(gt, left.shape)
-    if d_max is None:
-        d_max = default_d_max(gt)
-    t0 = time.perf_counter()
-    if left_xy is None or right_xy is None:
-        if threshold is None:
-            threshold = M.threshold_for_count(left, corners, k=k, nms=nms)
-        left_xy = M.detect_corners(left, k=k, threshold=threshold, nms=nms)
-        right_xy = M.detect_corners(right, k=k, threshold=threshold, nms=nms)
-    t1 = time.perf_counter()
-    if len(left_xy) == 0 or len(right_xy) == 0:
-        side = "left" if len(left_xy) == 0 else "right"
-        raise ValueError(f"no corners found in the {side} image (threshold code {threshold}); "
-                         "lower --threshold or ask for more --corners")
-    m = M.match_features(left, right, left_xy, right_xy, d_max=d_max, **match_kw)
-    t2 = time.perf_counter()
-    s = Q.sparse_scores(m.left, m.disparity, gt)
-    return dict(matches=m, scores=s, left_xy=np.asarray(left_xy), right_xy=np.asarray(right_xy),
-                threshold=threshold, d_max=int(d_max), seconds=t2 - t1, seconds_features=t1 - t0)
-
-
-def summary(result: dict) -> dict:
-    """The JSON-able figures of :func:`evaluate_pair`'s result."""
-    s: Q.Scores = result["scores"]
-    m: M.Matches = result["matches"]
-    p = dict(m.params)
-    p["window"] = list(p["window"])
-    out = {"matches": len(m), "good": s.good, "bad": s.bad,
-           "bad_percent": None if math.isnan(s.bad_percent) else round(s.bad_percent, 4),
-           "rms": None if math.isnan(s.rms) else round(s.rms, 6),
-           "seconds": round(result["seconds"], 6), "seconds_features": round(result["seconds_features"], 6),
-           "unknown": s.unknown, "evaluated": s.evaluated, "candidates": m.candidates,
-           "left_corners": int(len(result["left_xy"])), "right_corners": int(len(result["right_xy"])),
-           "threshold_code": None if result["threshold"] is None else int(np.max(result["threshold"])),
-           "params": p}
-    if "dense" in result:
-        out["dense"] = result["dense"]
-    return out
-
-
-def sweep_pair(left, right, gt, vary: str, values, *, repeat: int = 1, **kw) -> list[dict]:
-    """:func:`evaluate_pair` for each value of one matching parameter (corners detected once).
-
-    ``repeat`` > 1 times the matching step that many times and keeps the fastest."""
-    if vary not in VARY:
-        raise ValueError(f"vary must be one of {VARY}, got {vary!r}")
-    values = list(values)
-    if not values:
-        raise ValueError("no values to sweep")
-    base = evaluate_pair(left, right, gt, **kw)
-    kw = {k: v for k, v in kw.items() if k not in ("corners", "threshold", "k", "nms")}
-    kw["d_max"] = base["d_max"]
-    rows = []
-    for v in values:
-        best = None
-        for _ in range(max(1, repeat)):
-            r = evaluate_pair(left, right, gt, left_xy=base["left_xy"], right_xy=base["right_xy"],
-                              **{**kw, vary: v})
-            if best is None or r["seconds"] < best["seconds"]:
-                best = r
-        best["threshold"] = base["threshold"]
-        best["seconds_features"] = base["seconds_features"]
-        row = summary(best)
-        row["value"] = list(v) if isinstance(v, tuple) else v
-        rows.append(row)
-    return rows
-
-
-# --------------------------------------------------------------------------------------------------
-# Argument types
-
-
-class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors: ``eyestereo: error: ...`` and exit status 2."""
-
-    def error(self, message: str) -> NoReturn:
-        self.exit(2, f"{PROG}: error: {' '.join(message.split())}\n")
-
-
-def parse_window(text: str) -> tuple[int, int]:
-    """'9' or '5x7' (W x H) -> (W, H), odd sides 1..255."""
-    m = re.fullmatch(r"\s*(\d+)\s*(?:[xX]\s*(\d+)\s*)?", str(text))
-    if m is None:
-        raise ValueError(f"window must be N or WxH, e.g. 9 or 5x7; got {text!r}")
-    w = int(m.group(1))
-    h = int(m.group(2)) if m.group(2) else w
-    if not (1 <= w <= 255 and 1 <= h <= 255 and w % 2 and h % 2):
-        raise ValueError(f"window sides must be odd, 1..255; got {text!r}")
-    return w, h
-
-
-def _window_arg(text: str) -> tuple[int, int]:
-    try:
-        return parse_window(text)
-    except ValueError as e:
-        raise argparse.ArgumentTypeError(str(e)) from None
-
-
-def _num(text: str, kind=float, lo=None, hi=None, what="number"):
-    try:
-        v = kind(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a{'n integer' if kind is int else ' number'}: {text!r}") from None
-    if isinstance(v, float) and not math.isfinite(v):
-        raise argparse.ArgumentTypeError(f"must be finite, got {text!r}")
-    if (lo is not None and v < lo) or (hi is not None and v > hi):
-        rng = f"{lo if lo is not None else '-inf'}..{hi if hi is not None else 'inf'}"
-        raise argparse.ArgumentTypeError(f"{what} must lie in {rng}, got {text}")
-    return v
-
-
-def _pos_float(text):
-    v = _num(text)
-    if not v > 0:
-        raise argparse.ArgumentTypeError(f"must be a positive number, got {text!r}")
-    return v
-
-
-def parse_values(vary: str, text: str) -> list:
-    """'1,5,9' or 'a:b[:step]' (inclusive; t_max and rows) -> the list of values of parameter ``vary``."""
-    if vary not in VARY:
-        raise ValueError(f"vary must be one of {VARY}, got {vary!r}")
-    text = str(text).strip()
-    if not text:
-        raise ValueError("empty --values")
-    if ":" in text and vary in ("t_max", "rows"):
-        parts = text.split(":")
-        if len(parts) not in (2, 3):
-            raise ValueError(f"range must be a:b or a:b:step, got {text!r}")
-        try:
-            a, b = float(parts[0]), float(parts[1])
-            st = float(parts[2]) if len(parts) == 3 else 1.0
-        except ValueError:
-            raise ValueError(f"bad range {text!r}") from None
-        if not (st > 0 and b >= a and (b - a) / st <= 1000):
-            raise ValueError(f"range {text!r} must rise with a positive step (at most 1000 values)")
-        vals = [a + i * st for i in range(int(math.floor((b - a) / st + 1e-9)) + 1)]
-    else:
-        vals = [v.strip() for v in text.split(",") if v.strip()]
-    out = []
-    for v in vals:
-        if vary == "t_max":
-            f = float(v)
-            if not (math.isfinite(f) and f > 0):
-                raise ValueError(f"t_max values must be positive, got {v}")
-            out.append(round(f, 9))
-        elif vary == "rows":
-            f = float(v)
-            if f != int(f) or f < 0:
-                raise ValueError(f"rows values must be integers >= 0, got {v}")
-            out.append(int(f))
-        elif vary == "window":
-            out.append(parse_window(v))
-        elif vary == "split":
-            if v not in ("1", "5", "9"):
-                raise ValueError(f"split values must be 1, 5 or 9, got {v!r}")
-            out.append(int(v))
-        else:
-            if v not in M.COSTS:
-                raise ValueError(f"cost values must be among {', '.join(M.COSTS)}, got {v!r}")
-            out.append(v)
-    return out
+#: The files ``evaluate -o DIR`` writes (an existing DIR may hold only these).
+PICTURES = ("matches.png", "disparity.png", "dense.png")
 
 
 # --------------------------------------------------------------------------------------------------
 # Outputs
-
-
-def _error(msg: str) -> int:
-    print(f"{PROG}: error: {' '.join(str(msg).split())}", file=sys.stderr)
-    return 1
-
-
-def _check_out_file(path: Path) -> Path:
-    path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise ValueError(f"cannot write {path}: folder {folder} does not exist")
-    if path.is_dir():
-        raise ValueError(f"cannot write {path}: it is a folder")
-    return path
-
-
-def _tmp_beside(path: Path) -> Path:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
-    return Path(tmp)
-
-
-def _commit(writers: list[tuple[Path, Any]]) -> None:
-    """Write every output to a temporary file beside it, then rename all into place (all or nothing
-    as far as the file system allows: a failed write removes every temporary file)."""
-    done: list[tuple[Path, Path]] = []
-    try:
-        for path, write in writers:
-            tmp = _tmp_beside(path)
-            done.append((tmp, path))
-            write(tmp)
-            if tmp.stat().st_size == 0:
-                raise OSError(f"nothing was written to {path}")
-    except BaseException:
-        for tmp, _ in done:
-            tmp.unlink(missing_ok=True)
-        raise
-    for tmp, path in done:
-        os.replace(tmp, path)
 
 
 def _json_writer(doc: dict):
@@ -368,8 +143,7 @@ def _match_kw(args) -> dict:
 
 
 def _load(args):
-    left, right = M.load_grey(args.left), M.load_grey(args.right)
-    left, right = M.check_pair(left, right)
+    left, right = M.load_pair(args.left, args.right)
     gt = Q.check_gt(Q.load_disparity(args.gt, args.scale), left.shape)
     return left, right, gt
 
@@ -380,18 +154,9 @@ def _detect_kw(args) -> dict:
 
 def cmd_evaluate(args: argparse.Namespace) -> int:
     """Handler of ``evaluate``."""
-    try:
-        writers = []
-        if args.json is not None:
-            args.json = _check_out_file(args.json)
-        out_dir = None
-        if args.output is not None:
-            out_dir = Path(args.output)
-            if out_dir.exists() and not out_dir.is_dir():
-                raise ValueError(f"{out_dir} exists and is not a folder")
-            parent = out_dir.parent if str(out_dir.parent) else Path(".")
-            if not parent.is_dir():
-                raise ValueError(f"cannot create {out_dir}: folder {parent} does not exist")
+    with Outputs() as out:
+        json_tmp = None if args.json is None else out.file(args.json)
+        pics = None if args.output is None else out.folder(args.output, PICTURES)
         left, right, gt = _load(args)
         result = evaluate_pair(left, right, gt, **_detect_kw(args), **_match_kw(args))
         if args.dense:
@@ -403,32 +168,24 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
             ds = Q.dense_scores(dense, gt)
             result["dense"] = dict(ds.as_dict(), seconds=round(dt, 6), window=args.dense_window)
         doc = summary(result)
-        if args.json is not None:
-            writers.append((args.json, _json_writer(doc)))
-        if out_dir is not None:
-            writers.append((out_dir / "matches.png", _matches_writer(left, right, result, gt)))
-            writers.append((out_dir / "disparity.png", _disparity_writer(left, result, gt)))
+        if json_tmp is not None:
+            _json_writer(doc)(json_tmp)
+        written = []
+        if pics is not None:
+            _matches_writer(left, right, result, gt)(pics / "matches.png")
+            _disparity_writer(left, result, gt)(pics / "disparity.png")
+            written = ["matches.png", "disparity.png"]
             if args.dense:
-                writers.append((out_dir / "dense.png", _dense_writer(dense, gt, result["d_max"])))
-        made = out_dir is not None and not out_dir.exists()
-        if made:
-            out_dir.mkdir()
-        try:
-            _commit(writers)
-        except BaseException:
-            if made:
-                try:
-                    out_dir.rmdir()
-                except OSError:
-                    pass
-            raise
-    except (ValueError, OSError) as exc:
-        return _error(exc)
+                _dense_writer(dense, gt, result["d_max"])(pics / "dense.png")
+                written.append("dense.png")
     s = result["scores"]
     bp = "n/a" if math.isnan(s.bad_percent) else f"{s.bad_percent:.2f} %"
     rms = "n/a" if math.isnan(s.rms) else f"{s.rms:.3f} px"
+    p = result["matches"].params
+    what = f"NCC >= {p['ncc_min']:g}" if p["cost"] == "ncc" else f"{p['cost'].upper()} < t_max {p['t_max']:g}"
     print(f"corners: {len(result['left_xy'])} left, {len(result['right_xy'])} right (threshold code "
-          f"{doc['threshold_code']}); disparities 0..{result['d_max']}")
+          f"{doc['threshold_code']}); disparities 0..{result['d_max']}; {p['window'][0]}x{p['window'][1]} {what}"
+          f"{', left-right check' if p['lr_check'] else ''}")
     print(f"matches: {len(result['matches'])} ({s.good} good, {s.bad} bad, {s.unknown} without ground truth); "
           f"bad {bp}; RMS {rms}; matching {result['seconds'] * 1e3:.2f} ms")
     if args.dense:
@@ -437,8 +194,10 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         drms = "n/a" if d["rms"] is None else f"{d['rms']:.3f} px"
         print(f"dense SAD {args.dense_window}x{args.dense_window}: {d['evaluated']} pixels, bad {dbp}, "
               f"RMS {drms}, {d['seconds'] * 1e3:.1f} ms")
-    for path, _ in writers:
-        print(f"-> {path}")
+    if args.json is not None:
+        print(f"-> {args.json}")
+    for name in written:
+        print(f"-> {Path(args.output) / name}")
     return 0
 
 
@@ -448,13 +207,14 @@ def _sweep_plot_writer(rows: list[dict], vary: str):
         ax = fig.add_subplot(111)
         labels = [("x".join(map(str, r["value"])) if isinstance(r["value"], list) else str(r["value"])) for r in rows]
         x = np.arange(len(rows))
-        if vary in ("t_max", "rows"):
+        numeric = vary in ("t_max", "rows", "ncc_min")
+        if numeric:
             x = np.array([r["value"] for r in rows], float)
         ax.plot(x, [r["matches"] for r in rows], "o-", label="matches")
         ax.plot(x, [r["good"] for r in rows], "s-", label="good")
         ax.plot(x, [r["bad"] for r in rows], "^-", label="bad (|e| > 1)")
         ax.set_xlabel(vary)
-        if vary not in ("t_max", "rows"):
+        if not numeric:
             ax.set_xticks(x, labels)
         ax.set_ylabel("count")
         ax2 = ax.twinx()
@@ -472,24 +232,19 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     try:
         values = parse_values(args.vary, args.values)
     except ValueError as exc:
-        print(f"{PROG}: error: argument --values: {' '.join(str(exc).split())}", file=sys.stderr)
-        return 2
-    try:
-        for p in (args.json, args.plot):
-            if p is not None:
-                _check_out_file(p)
+        print_error(f"argument --values: {exc}")
+        return EXIT_USAGE
+    with Outputs() as out:
+        json_tmp = None if args.json is None else out.file(args.json)
+        plot_tmp = None if args.plot is None else out.file(args.plot)
         left, right, gt = _load(args)
         kw = {**_detect_kw(args), **_match_kw(args)}
         kw.pop(args.vary, None)
         rows = sweep_pair(left, right, gt, args.vary, values, repeat=args.repeat, **kw)
-        writers = []
-        if args.json is not None:
-            writers.append((Path(args.json), _json_writer({"vary": args.vary, "rows": rows})))
-        if args.plot is not None:
-            writers.append((Path(args.plot), _sweep_plot_writer(rows, args.vary)))
-        _commit(writers)
-    except (ValueError, OSError) as exc:
-        return _error(exc)
+        if json_tmp is not None:
+            _json_writer({"vary": args.vary, "rows": rows})(json_tmp)
+        if plot_tmp is not None:
+            _sweep_plot_writer(rows, args.vary)(plot_tmp)
     print(f"{'value':>8} {'matches':>8} {'good':>6} {'bad':>5} {'bad %':>7} {'RMS px':>7} {'ms':>8}")
     for r in rows:
         v = "x".join(map(str, r["value"])) if isinstance(r["value"], list) else str(r["value"])
@@ -503,45 +258,52 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _add_common(p: argparse.ArgumentParser) -> None:
+    d = DEFAULTS
     p.add_argument("left", metavar="LEFT", help="rectified left image")
     p.add_argument("right", metavar="RIGHT", help="rectified right image (same size)")
-    p.add_argument("gt", metavar="GT", help="ground-truth disparity of the left view (PGM/PNG, PFM or .npy)")
-    p.add_argument("--scale", type=_pos_float, default=1.0,
+    p.add_argument("gt", metavar="GT", help="ground-truth disparity of the left view (PGM/PNG, PFM or .npy); "
+                   "used for scoring only")
+    p.add_argument("--scale", type=positive, default=1.0,
                    help="GT value per pixel of disparity (Middlebury: 16 Tsukuba, 8 Venus; default 1); 0 = unknown")
     g = p.add_argument_group("corners (bit-true Harris model)")
-    g.add_argument("--corners", type=lambda t: _num(t, int, 1, 100000, "--corners"), default=500,
-                   help="aim at this many corners in the left image (default 500)")
-    g.add_argument("--threshold", type=lambda t: _num(t, int, 0, (1 << 19) - 1, "--threshold"), default=None,
+    g.add_argument("--corners", type=lambda t: number(t, int, 1, 100000, "--corners"), default=d["corners"],
+                   help=f"aim at this many corners in the left image (default {d['corners']})")
+    g.add_argument("--threshold", type=lambda t: number(t, int, 0, (1 << 19) - 1, "--threshold"), default=None,
                    help="threshold code instead of --corners (same for both images)")
-    g.add_argument("--k", type=lambda t: _num(t, float, 0, 255 / 256, "--k"), default=0.04,
-                   help="Harris k (default 0.04)")
-    g.add_argument("--nms", type=int, choices=(1, 3, 5), default=3, help="NMS window (default 3)")
-    g = p.add_argument_group("matching")
-    g.add_argument("--window", type=_window_arg, default=(9, 9), help="window WxH or N, odd (default 9x9)")
-    g.add_argument("--t-max", dest="t_max", type=_pos_float, default=11.0,
-                   help="accept SAD < t_max*W*H (SSD: < t_max^2*W*H; default 11)")
-    g.add_argument("--cost", choices=M.COSTS, default="sad", help="cost function (default sad)")
-    g.add_argument("--ncc-min", dest="ncc_min", type=lambda t: _num(t, float, -1, 1, "--ncc-min"), default=0.8,
-                   help="NCC acceptance (default 0.8)")
-    g.add_argument("--split", type=int, choices=M.SPLITS, default=1,
-                   help="split correlation: 1 window, 5 or 9 windows (default 1)")
-    g.add_argument("--rows", type=lambda t: _num(t, int, 0, 16, "--rows"), default=0,
+    g.add_argument("--k", type=lambda t: number(t, float, 0, 255 / 256, "--k"), default=d["k"],
+                   help=f"Harris k (default {d['k']})")
+    g.add_argument("--nms", type=int, choices=(1, 3, 5), default=d["nms"], help=f"NMS window (default {d['nms']})")
+    g = p.add_argument_group("matching (defaults: NCC 11x11 >= 0.75, left-right check, disparities 0..width/4)")
+    g.add_argument("--cost", choices=M.COSTS, default=d["cost"], help=f"cost function (default {d['cost']})")
+    g.add_argument("--window", type=window, default=d["window"],
+                   help=f"window WxH or N, odd (default {d['window'][0]}x{d['window'][1]})")
+    g.add_argument("--ncc-min", dest="ncc_min", type=lambda t: number(t, float, -1, 1, "--ncc-min"),
+                   default=d["ncc_min"], help=f"NCC: accept NCC >= this (default {d['ncc_min']})")
+    g.add_argument("--t-max", dest="t_max", type=positive, default=d["t_max"],
+                   help=f"SAD: accept SAD < t_max*W*H; SSD: < t_max^2*W*H (default {d['t_max']:g})")
+    g.add_argument("--split", type=int, choices=M.SPLITS, default=d["split"],
+                   help="split correlation (SAD, SSD): 1 window, 5 or 9 windows (default 1)")
+    g.add_argument("--rows", type=lambda t: number(t, int, 0, 16, "--rows"), default=d["rows"],
                    help="also search +-ROWS rows (default 0)")
-    g.add_argument("--lr-check", dest="lr_check", action="store_true", help="left-right consistency check")
-    g.add_argument("--max-disparity", dest="max_disparity", type=lambda t: _num(t, int, 0, 100000, "--max-disparity"),
-                   default=None, help="disparity range 0..D (default: ceil(max GT) + 1)")
+    g.add_argument("--lr-check", dest="lr_check", action=argparse.BooleanOptionalAction, default=d["lr_check"],
+                   help="left-right consistency check (default on)")
+    g.add_argument("--max-disparity", dest="max_disparity",
+                   type=lambda t: number(t, int, 0, 100000, "--max-disparity"), default=None,
+                   help="disparity range 0..D (default: a quarter of the image width)")
 
 
 def register(subparsers: Any) -> None:
     """Add the ``evaluate`` and ``sweep`` sub-commands to an ``argparse`` sub-parsers object."""
     p = subparsers.add_parser(
         "evaluate", help="feature matching on a stereo pair with ground truth: figures, JSON, PNGs",
-        description="Harris corners (bit-true model) of both images, SAD/SSD/NCC matching along the rows "
-                    "(thesis 7.3), RMS error and bad matches (|d - d_true| > 1) against the ground truth.")
+        description="Harris corners (bit-true model) of both images, matching along the rows (thesis 7.3), "
+                    "RMS error and bad matches (|d - d_true| > 1) against the ground truth, which is used "
+                    "for scoring only.")
     _add_common(p)
     p.add_argument("--json", type=Path, default=None, help="write the figures to this JSON file")
     p.add_argument("-o", "--output", type=Path, default=None,
-                   help="folder for matches.png, disparity.png (and dense.png); created if missing")
+                   help="folder for matches.png, disparity.png (and dense.png); created, or replaced when it "
+                        "holds only these")
     p.add_argument("--dense", action="store_true", help="also dense SAD block matching over all pixels")
     p.add_argument("--dense-window", dest="dense_window", type=int, choices=range(3, 32, 2), default=9,
                    metavar="N", help="dense SAD window (odd, default 9)")
@@ -554,35 +316,10 @@ def register(subparsers: Any) -> None:
     _add_common(q)
     q.add_argument("--vary", choices=VARY, required=True, help="parameter to sweep")
     q.add_argument("--values", required=True,
-                   help="comma list (t_max 5,9,11; window 5x7,9; split 1,5,9; cost sad,ncc) or a:b[:step] "
-                        "for t_max and rows")
-    q.add_argument("--repeat", type=lambda t: _num(t, int, 1, 100, "--repeat"), default=1,
+                   help="comma list (t_max 5,9,11; window 5x7,9; split 1,5,9; cost sad,ncc; ncc_min 0.7,0.8) "
+                        "or a:b[:step] for t_max, ncc_min and rows")
+    q.add_argument("--repeat", type=lambda t: number(t, int, 1, 100, "--repeat"), default=1,
                    help="time each matching this many times, keep the fastest (default 1)")
     q.add_argument("--json", type=Path, default=None, help="write the table to this JSON file")
     q.add_argument("--plot", type=Path, default=None, help="write a PNG plot of the table")
     q.set_defaults(func=cmd_sweep)
-
-
-def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog=PROG, description="Sparse stereo matching evaluation (thesis 7.3).")
-    register(parser.add_subparsers(dest="command", metavar="COMMAND", required=True))
-    return parser
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Run ``evaluate``/``sweep``; returns the exit status (0 ok, 1 run-time error, 2 usage error)."""
-    try:
-        args = build_parser().parse_args(None if argv is None else [str(a) for a in argv])
-    except SystemExit as e:
-        return e.code if isinstance(e.code, int) else (0 if e.code is None else 2)
-    try:
-        return int(args.func(args))
-    except KeyboardInterrupt:
-        _error("interrupted")
-        return 130
-    except Exception as e:  # noqa: BLE001 - one line, never a traceback
-        return _error(f"{type(e).__name__}: {e}")
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -19,6 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
+from eyestereo.tools.io import read_image
+
 __all__ = ["Scores", "load_disparity", "gt_from_array", "check_gt", "sparse_scores", "dense_scores",
            "read_pfm"]
 
@@ -66,9 +68,14 @@ def read_pfm(path) -> np.ndarray:
         head = fh.readline().strip()
         if head not in (b"Pf", b"PF"):
             raise ValueError(f"{path} is not a PFM file")
-        dims = fh.readline().split()
-        scale = float(fh.readline().strip())
-        w, h = int(dims[0]), int(dims[1])
+        try:
+            dims = fh.readline().split()
+            scale = float(fh.readline().strip())
+            w, h = int(dims[0]), int(dims[1])
+        except (ValueError, IndexError):
+            raise ValueError(f"{path}: malformed PFM header") from None
+        if not (0 < w <= 65536 and 0 < h <= 65536 and math.isfinite(scale) and scale != 0):
+            raise ValueError(f"{path}: implausible PFM header ({w}x{h}, scale {scale})")
         ch = 3 if head == b"PF" else 1
         data = np.frombuffer(fh.read(), dtype="<f4" if scale < 0 else ">f4")
     if data.size != w * h * ch:
@@ -80,8 +87,6 @@ def read_pfm(path) -> np.ndarray:
 def load_disparity(path, scale: float = 1.0) -> np.ndarray:
     """Ground truth from a file: PGM/PNG (8 or 16 bit, value = d * scale, 0 = unknown), PFM or .npy
     (float disparities, scaled the same way; 0, NaN and inf = unknown)."""
-    import cv2
-
     p = Path(path)
     if not p.is_file():
         raise ValueError(f"ground truth {p} does not exist")
@@ -91,13 +96,14 @@ def load_disparity(path, scale: float = 1.0) -> np.ndarray:
     elif suffix == ".npy":
         try:
             raw = np.load(p, allow_pickle=False)
-        except Exception as e:  # noqa: BLE001
-            raise ValueError(f"cannot read {p}: {e}") from None
+        except Exception:  # noqa: BLE001 - numpy raises many kinds for a bad file
+            raise ValueError(f"cannot read ground truth {p}: not a readable .npy file") from None
     else:
-        raw = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
-        if raw is None:
-            raise ValueError(f"cannot read {p} as an image")
-    return gt_from_array(raw, scale=scale)
+        raw = read_image(p, what="ground truth")
+    try:
+        return gt_from_array(raw, scale=scale)
+    except ValueError as e:
+        raise ValueError(f"ground truth {p}: {e}") from None
 
 
 def check_gt(gt, shape) -> np.ndarray:

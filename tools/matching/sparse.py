@@ -26,13 +26,13 @@ All of it is vectorized: the candidate pairs come from one sort of the right cor
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
+from eyestereo.tools.io import read_image, to_grey8
 from eyestereo.tools.models import harris_mono as _hm
 
-__all__ = ["COSTS", "SPLITS", "Matches", "as_grey", "load_grey", "check_pair", "check_features",
+__all__ = ["COSTS", "SPLITS", "Matches", "as_grey", "load_grey", "load_pair", "check_pair", "check_features",
            "threshold_for_count", "detect_corners", "match_features", "split_offsets"]
 
 COSTS = ("sad", "ssd", "ncc")
@@ -69,16 +69,19 @@ def as_grey(img, *, order: str = "rgb") -> np.ndarray:
 
 
 def load_grey(path) -> np.ndarray:
-    """Read an image file as 8-bit grey (colour converted by OpenCV); ValueError if unreadable."""
-    import cv2
+    """Read an image file as 8-bit grey (:func:`eyestereo.tools.io.read_image` and
+    :func:`~eyestereo.tools.io.to_grey8`: damaged files refused, colour to grey, 16-bit to its 8 most
+    significant used bits, floating point refused); ValueError naming the file otherwise."""
+    return to_grey8(read_image(path, grey=True), f"image {path}")
 
-    p = Path(path)
-    if not p.is_file():
-        raise ValueError(f"image {p} does not exist")
-    img = cv2.imread(str(p), cv2.IMREAD_GRAYSCALE)
-    if img is None:
-        raise ValueError(f"cannot read {p} as an image")
-    return img
+
+def load_pair(left_path, right_path) -> tuple[np.ndarray, np.ndarray]:
+    """A stereo pair as 8-bit grey, like :func:`load_grey`; 16-bit images share one shift, so both
+    views keep the same scale. ValueError unless both are readable and of the same size."""
+    imgs = [read_image(left_path, what="left image", grey=True),
+            read_image(right_path, what="right image", grey=True)]
+    left, right = to_grey8(imgs, [f"left image {left_path}", f"right image {right_path}"])
+    return check_pair(left, right)
 
 
 def check_pair(left, right) -> tuple[np.ndarray, np.ndarray]:
@@ -330,7 +333,7 @@ def match_features(left, right, left_xy, right_xy, *, window=(9, 9), t_max: floa
         raise ValueError(f"cost must be one of {COSTS}, got {cost!r}")
     offsets = split_offsets((w, h), split)
     if cost == "ncc" and split != 1:
-        raise ValueError("split correlation is defined for SAD and SSD only")
+        raise ValueError("split correlation is defined for the SAD and SSD costs only, not for NCC")
     if not (np.isfinite(t_max) and t_max > 0):
         raise ValueError(f"t_max must be a positive number, got {t_max}")
     if not -1 <= ncc_min <= 1:

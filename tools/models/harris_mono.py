@@ -10,6 +10,8 @@ c = det(M) - k trace(M)^2. The hardware's cornerness code is c / 2**21 up to qua
 
 from __future__ import annotations
 
+import numbers
+
 import numpy as np
 
 from eyestereo.tools.models import cornerness as _corner
@@ -44,8 +46,8 @@ def radius(nms: int) -> int:
 
 
 def check_params(width: int, height: int, blocks: tuple[int, int], nms: int) -> None:
-    if nms not in (1, 3, 5):
-        raise ValueError(f"nms must be 1, 3 or 5, got {nms!r}")
+    if isinstance(nms, bool) or not isinstance(nms, numbers.Integral) or nms not in (1, 3, 5):
+        raise ValueError(f"parameter nms must be 1, 3 or 5, got {nms!r}")
     _pre.check_blocks(width, height, blocks)
 
 

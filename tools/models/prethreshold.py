@@ -2,17 +2,22 @@
 
 from __future__ import annotations
 
+import numbers
+
 import numpy as np
 
 
-def check_blocks(width: int, height: int, blocks) -> None:
-    """ValueError unless blocks is a pair (BX, BY) of ints, each 1..16 and at most the frame size."""
-    if (not isinstance(blocks, (tuple, list)) or len(blocks) != 2
-            or not all(isinstance(b, int) and not isinstance(b, bool) for b in blocks)):
-        raise ValueError(f"blocks must be a pair of ints (BX, BY), got {blocks!r}")
-    bx, by = blocks
+def check_blocks(width: int, height: int, blocks) -> tuple[int, int]:
+    """``blocks`` as a pair of Python ints (BX, BY); ValueError unless it is a pair of integers (numpy
+    integers too, not floats or bools), each 1..16 and at most the frame's width / height."""
+    if (not isinstance(blocks, (tuple, list, np.ndarray)) or len(blocks) != 2
+            or not all(isinstance(b, numbers.Integral) and not isinstance(b, (bool, np.bool_)) for b in blocks)):
+        raise ValueError(f"parameter blocks must be a pair of ints (BX, BY), got {blocks!r}")
+    bx, by = (int(b) for b in blocks)
     if not (1 <= bx <= min(16, width) and 1 <= by <= min(16, height)):
-        raise ValueError(f"blocks={tuple(blocks)}: BX and BY must be 1..16 and at most the frame's width/height")
+        raise ValueError(f"parameter blocks={(bx, by)}: BX and BY must be 1..16 and at most the frame's "
+                         f"width/height ({width}x{height})")
+    return bx, by
 
 
 def block_edges(size: int, blocks: int) -> np.ndarray:

@@ -18,18 +18,16 @@ The thesis calibrated the EyeBot M6 stereo rig with Bouguet's Camera Calibration
 
 The result is a :class:`StereoCalibration`, stored as an OpenCV FileStorage YAML file with exactly the
 keys ``M1, D1, M2, D2, R, T, image_width, image_height, rms`` (:func:`write_yaml`, :func:`read_yaml`).
-Every file this toolbox writes is written atomically (:func:`atomic_output`): a temporary file in the
-same folder, renamed over the target only when complete.
+Every file this toolbox writes is written atomically (:func:`eyestereo.tools.io.atomic_output`): a
+temporary file in the same folder, renamed over the target only when complete.
 """
 
 from __future__ import annotations
 
-import contextlib
 import glob as _glob
 import os
 import re
-import tempfile
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -37,13 +35,12 @@ from typing import Any
 import cv2
 import numpy as np
 
-from eyestereo.tools.progress import Progress
+from eyestereo.tools.io import atomic_output, read_image, to_grey8
+from eyestereo.tools.progress import progress_bar
 
 __all__ = [
     "YAML_KEYS",
     "StereoCalibration",
-    "atomic_output",
-    "atomic_write_bytes",
     "board_object_points",
     "calibrate_stereo",
     "expand_images",
@@ -60,53 +57,19 @@ YAML_KEYS = ("M1", "D1", "M2", "D2", "R", "T", "image_width", "image_height", "r
 #: + s1..s4 (thin prism), + tau_x tau_y (tilted sensor).
 DIST_LENGTHS = (4, 5, 8, 12, 14)
 
+#: Plausibility limits of a calibration (see ``StereoCalibration._check_plausible``): image side;
+#: focal length as a multiple of the image side (a field of view of 170 .. 0.1 degrees); distortion
+#: coefficients; baseline (units of the square size); reprojection error (px).
+MAX_IMAGE_SIDE = 16384
+#: The square size a calibration accepts (any unit: 1e-6 .. 1e6 keeps OpenCV's arithmetic sound).
+SQUARE_RANGE = (1e-6, 1e6)
+FOCAL_RANGE = (1 / (2 * np.tan(np.radians(85))), 1 / (2 * np.tan(np.radians(0.05))))
+MAX_DISTORTION = 1e4
+MAX_BASELINE = 1e6
+MAX_RMS = 1e3
+
 _SUBPIX_CRITERIA = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 60, 1e-4)
 _CALIB_CRITERIA = (cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 200, 1e-9)
-
-
-# --------------------------------------------------------------------------------------------------
-# Atomic output
-
-
-@contextlib.contextmanager
-def atomic_output(path: str | os.PathLike[str], suffix: str | None = None) -> Iterator[Path]:
-    """Yield a temporary path beside ``path``; on success rename it over ``path``, else delete it.
-
-    The temporary name keeps ``path``'s suffix (or ``suffix``) so that writers which pick the format
-    from the name (OpenCV's FileStorage and imwrite, matplotlib) write the right format.
-    """
-    target = Path(path)
-    folder = target.parent if str(target.parent) else Path(".")
-    if not folder.is_dir():
-        raise ValueError(f"cannot write {target}: folder {folder} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix or target.suffix, dir=folder)
-    os.close(fd)
-    tmp_path = Path(tmp)
-    try:
-        yield tmp_path
-        if not tmp_path.exists() or tmp_path.stat().st_size == 0:
-            raise ValueError(f"writing {target} produced no data")
-        os.chmod(tmp_path, _file_mode(target))
-        os.replace(tmp_path, target)
-    finally:
-        with contextlib.suppress(FileNotFoundError):
-            tmp_path.unlink()
-
-
-def _file_mode(target: Path) -> int:
-    """The mode a plainly created file would get (mkstemp makes 0600): the old file's, else 0666 & ~umask."""
-    try:
-        return target.stat().st_mode & 0o777
-    except OSError:
-        mask = os.umask(0o022)
-        os.umask(mask)
-        return 0o666 & ~mask
-
-
-def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
-    """Write ``data`` to ``path`` atomically."""
-    with atomic_output(path) as tmp:
-        tmp.write_bytes(data)
 
 
 # --------------------------------------------------------------------------------------------------
@@ -159,6 +122,36 @@ class StereoCalibration:
                 raise ValueError(f"{name} is not a camera matrix [[fx s cx] [0 fy cy] [0 0 1]] with fx, fy > 0")
         if np.linalg.norm(self.T) == 0:
             raise ValueError("T is zero: the two cameras must not coincide")
+        self._check_plausible()
+
+    def _check_plausible(self) -> None:
+        """Refuse values no camera has (they pass the shape checks and then overflow or mislead)."""
+        w, h = self.image_width, self.image_height
+        if w > MAX_IMAGE_SIDE or h > MAX_IMAGE_SIDE:
+            raise ValueError(f"image size {w}x{h} is implausible (at most {MAX_IMAGE_SIDE} pixels per side)")
+        for name in ("M1", "M2"):
+            m = getattr(self, name)
+            for k, (i, side, n) in {"fx": (0, "wide", w), "fy": (1, "high", h)}.items():
+                lo, hi = n * FOCAL_RANGE[0], n * FOCAL_RANGE[1]
+                if not lo <= m[i, i] <= hi:
+                    raise ValueError(
+                        f"{name}: focal length {k} = {m[i, i]:.6g} px is implausible for an image {n} px {side} "
+                        f"(a field of view of 0.1 to 170 degrees needs {lo:.3g} .. {hi:.3g} px)")
+            if not (-w <= m[0, 2] <= 2 * w and -h <= m[1, 2] <= 2 * h):
+                raise ValueError(f"{name}: principal point ({m[0, 2]:.6g}, {m[1, 2]:.6g}) lies implausibly far "
+                                 f"outside the {w}x{h} image")
+            if abs(m[0, 1]) > m[0, 0]:
+                raise ValueError(f"{name}: skew {m[0, 1]:.6g} is implausible (larger than fx)")
+        for name in ("D1", "D2"):
+            d = getattr(self, name)
+            if np.abs(d).max() > MAX_DISTORTION:
+                raise ValueError(f"{name}: distortion coefficient {d[np.argmax(np.abs(d))]:.6g} is implausible "
+                                 f"(|k| <= {MAX_DISTORTION:g})")
+        if np.linalg.norm(self.T) > MAX_BASELINE:
+            raise ValueError(f"T: a baseline of {np.linalg.norm(self.T):.6g} is implausible (at most {MAX_BASELINE:g} "
+                             "units of the square size)")
+        if self.rms > MAX_RMS:
+            raise ValueError(f"rms {self.rms:.6g} px is implausible (at most {MAX_RMS:g})")
 
     @property
     def image_size(self) -> tuple[int, int]:
@@ -325,13 +318,14 @@ def _read_node(node: Any, key: str, p: Path) -> Any:
 
 
 def parse_board(text: str) -> tuple[int, int]:
-    """``"9x6"`` -> ``(9, 6)``: inner corners per row and per column, each at least 2."""
+    """``"9x6"`` -> ``(9, 6)``: inner corners per row and per column, each 3..100 (OpenCV's finder needs
+    more than 2)."""
     m = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", str(text))
     if m is None:
         raise ValueError(f"board must be COLSxROWS inner corners, e.g. 9x6; got {text!r}")
     cols, rows = int(m.group(1)), int(m.group(2))
-    if cols < 2 or rows < 2 or cols > 100 or rows > 100:
-        raise ValueError(f"board needs 2..100 inner corners per side, got {cols}x{rows}")
+    if cols < 3 or rows < 3 or cols > 100 or rows > 100:
+        raise ValueError(f"board needs 3..100 inner corners per side, got {cols}x{rows}")
     if cols == rows:
         raise ValueError(f"a square board ({cols}x{rows}) has an ambiguous orientation; use e.g. 9x6")
     return cols, rows
@@ -340,8 +334,8 @@ def parse_board(text: str) -> tuple[int, int]:
 def board_object_points(board: tuple[int, int], square: float) -> np.ndarray:
     """The board's inner corners in its own frame (z = 0), in OpenCV's row-major corner order."""
     cols, rows = board
-    if not square > 0:
-        raise ValueError(f"square size must be > 0, got {square}")
+    if not SQUARE_RANGE[0] <= square <= SQUARE_RANGE[1]:
+        raise ValueError(f"square size must lie in {SQUARE_RANGE[0]:g} .. {SQUARE_RANGE[1]:g} (any unit), got {square}")
     obj = np.zeros((rows * cols, 3), np.float32)
     obj[:, :2] = np.mgrid[0:cols, 0:rows].T.reshape(-1, 2) * square
     return obj
@@ -459,7 +453,12 @@ def find_corners(gray: np.ndarray, board: tuple[int, int], refine: str = "saddle
     if gray.ndim != 2 or gray.dtype != np.uint8:
         raise ValueError(f"find_corners wants a 2-D uint8 grey image, got {gray.dtype} {gray.shape}")
     flags = cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE
-    ok, corners = cv2.findChessboardCorners(gray, board, flags=flags)
+    if min(gray.shape) < 4 * min(board) or max(gray.shape) < 4 * max(board):
+        return None  # too small to hold the board (and OpenCV's finder asserts on tiny images)
+    try:
+        ok, corners = cv2.findChessboardCorners(gray, board, flags=flags)
+    except cv2.error:  # OpenCV refuses some degenerate images outright: no board there
+        return None
     if not ok or corners is None or len(corners) != board[0] * board[1]:
         return None
     grid = corners.reshape(board[1], board[0], 2)
@@ -487,25 +486,9 @@ def expand_images(spec: str | os.PathLike[str] | Sequence[Any], side: str) -> li
 
 def _load_gray(item: Any) -> tuple[np.ndarray, str]:
     if isinstance(item, np.ndarray):
-        img = item
-        name = "<array>"
-    else:
-        name = os.fspath(item)
-        if not os.path.isfile(name):
-            raise ValueError(f"image {name} does not exist")
-        img = cv2.imread(name, cv2.IMREAD_UNCHANGED)
-        if img is None:
-            raise ValueError(f"cannot read image {name} (not an image file?)")
-    if img.ndim == 3:
-        img = cv2.cvtColor(img, cv2.COLOR_BGRA2GRAY if img.shape[2] == 4 else cv2.COLOR_BGR2GRAY)
-    if img.ndim != 2:
-        raise ValueError(f"image {name} is not a grey or colour image (shape {img.shape})")
-    if img.dtype != np.uint8:
-        if img.dtype == np.uint16:
-            img = (img >> 8).astype(np.uint8)
-        else:
-            raise ValueError(f"image {name} has unsupported pixel type {img.dtype}")
-    return img, name
+        return to_grey8(item, "image <array>"), "<array>"
+    name = os.fspath(item)
+    return to_grey8(read_image(name, grey=True), f"image {name}"), name
 
 
 # --------------------------------------------------------------------------------------------------
@@ -515,14 +498,17 @@ def _load_gray(item: Any) -> tuple[np.ndarray, str]:
 def calibrate_stereo(left: str | Sequence[Any], right: str | Sequence[Any], *,
                      board: tuple[int, int] = (9, 6), square: float = 0.025, refine: bool = True,
                      log: Callable[[str], None] | None = None,
-                     progress: bool | None = None) -> StereoCalibration:
+                     progress: bool | None = None, judge: bool = True) -> StereoCalibration:
     """Calibrate a stereo rig from chessboard image pairs.
 
     ``left``/``right``: glob patterns (sorted, paired in order), lists of paths or lists of grey
     uint8 arrays. ``board``: inner corners (cols, rows); ``square``: square size (the unit of ``T``).
     ``refine``: refine the intrinsics in the stereo step (default) or keep the per-camera ones.
-    ``log`` receives one line per skipped pair. Raises ValueError on unreadable images, mixed image
-    sizes, unequal list lengths, or fewer than 3 pairs with the board found in both images.
+    ``log`` receives one line per skipped pair. Raises ValueError on unreadable or damaged images,
+    mixed image sizes, unequal list lengths, identical left and right images, or fewer than 3 pairs
+    with the board found in both images; with ``judge`` (default) the result is checked by
+    :func:`eyestereo.tools.rectify.judge.judge_calibration` (a :class:`~eyestereo.tools.rectify.judge.CalibrationProblem`
+    names the camera and the remedy) and ``info["notes"]`` holds its notes.
     """
     lefts = expand_images(left, "left")
     rights = expand_images(right, "right")
@@ -535,7 +521,7 @@ def calibrate_stereo(left: str | Sequence[Any], right: str | Sequence[Any], *,
     used: list[tuple[str, str]] = []
     skipped: list[tuple[str, str, str]] = []
     size: tuple[int, int] | None = None
-    with Progress(len(lefts), "chessboard corners", force=progress) as bar:
+    with progress_bar(len(lefts), "chessboard corners", force=progress) as bar:
         for a, b in zip(lefts, rights):
             (ga, na), (gb, nb) = _load_gray(a), _load_gray(b)
             for g, n in ((ga, na), (gb, nb)):
@@ -544,6 +530,9 @@ def calibrate_stereo(left: str | Sequence[Any], right: str | Sequence[Any], *,
                     size = s
                 elif s != size:
                     raise ValueError(f"image {n} is {s[0]}x{s[1]} but the first image is {size[0]}x{size[1]}")
+            if ga.shape == gb.shape and np.array_equal(ga, gb):
+                raise ValueError(f"the left and right images of a pair are identical ({Path(na).name} / "
+                                 f"{Path(nb).name}): give each camera's own images")
             ca, cb = find_corners(ga, board), find_corners(gb, board)
             bar.update()
             if ca is None or cb is None:
@@ -566,15 +555,46 @@ def calibrate_stereo(left: str | Sequence[Any], right: str | Sequence[Any], *,
         raise ValueError(f"the {board[0]}x{board[1]} board was found in both images of only {len(used)} "
                          f"of {len(lefts)} pairs; at least 3 are needed")
     assert size is not None
-    rms1, m1, d1, _, _ = cv2.calibrateCamera(objpoints, pts_l, size, None, None, criteria=_CALIB_CRITERIA)
-    rms2, m2, d2, _, _ = cv2.calibrateCamera(objpoints, pts_r, size, None, None, criteria=_CALIB_CRITERIA)
+    rms1, m1, d1, _, tv1, sd1 = _calibrate_one(objpoints, pts_l, size)
+    rms2, m2, d2, _, _, sd2 = _calibrate_one(objpoints, pts_r, size)
     flags = cv2.CALIB_USE_INTRINSIC_GUESS if refine else cv2.CALIB_FIX_INTRINSIC
-    rms, m1, d1, m2, d2, r, t, _, _ = cv2.stereoCalibrate(
-        objpoints, pts_l, pts_r, m1, d1, m2, d2, size, flags=flags, criteria=_CALIB_CRITERIA)
+    try:
+        rms, m1, d1, m2, d2, r, t, _, _ = cv2.stereoCalibrate(
+            objpoints, pts_l, pts_r, m1, d1, m2, d2, size, flags=flags, criteria=_CALIB_CRITERIA)
+    except cv2.error as e:
+        raise ValueError(f"the stereo calibration failed ({_cv_reason(e)}): use more views, with the board in "
+                         "different positions and angles") from None
     if not np.isfinite(rms):
         raise ValueError("stereo calibration did not converge")
-    calib = StereoCalibration(m1, d1, m2, d2, r, t, size[0], size[1], rms)
+    try:
+        calib = StereoCalibration(m1, d1, m2, d2, r, t, size[0], size[1], rms)
+    except ValueError as e:
+        raise ValueError(f"the calibration failed ({e}): add views with the board in more positions") from None
     calib.info.update(used=used, skipped=skipped, rms_left=float(rms1), rms_right=float(rms2),
                       refine=refine, board=tuple(board), square=float(square),
-                      points_left=pts_l, points_right=pts_r)
+                      points_left=pts_l, points_right=pts_r,
+                      board_distance=float(np.median([np.linalg.norm(v) for v in tv1])),
+                      focal_spread_left=float(sd1[0] / m1[0, 0]), focal_spread_right=float(sd2[0] / m2[0, 0]))
+    if judge:
+        from eyestereo.tools.rectify.judge import judge_calibration
+
+        calib.info["notes"] = judge_calibration(calib, where="calibration refused")
     return calib
+
+
+def _cv_reason(e: Exception) -> str:
+    """What an OpenCV exception of the calibration means to the user (its assertion text would not help)."""
+    return "OpenCV found the views degenerate"
+
+
+def _calibrate_one(objpoints: list[np.ndarray], points: list[np.ndarray], size: tuple[int, int]) -> tuple:
+    """One camera: (rms, M, D, rvecs, tvecs, standard deviations of fx, fy, cx, cy, k1, ...)."""
+    try:
+        rms, m, d, rv, tv, sd, _, _ = cv2.calibrateCameraExtended(objpoints, points, size, None, None,
+                                                                   criteria=_CALIB_CRITERIA)
+    except cv2.error as e:
+        raise ValueError(f"the calibration failed ({_cv_reason(e)}): use more views, with the board in "
+                         "different positions and angles") from None
+    sd = np.asarray(sd, np.float64).ravel()
+    sd = np.where(np.isfinite(sd), sd, np.inf)
+    return rms, m, d, rv, tv, sd

@@ -55,7 +55,6 @@ import json
 import math
 import numbers
 import os
-import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
@@ -66,6 +65,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from eyestereo.tools.io import atomic_write_text
 from eyestereo.tools.fixed import MAX_ARRAY_WL, Fmt, quantize, to_real
 
 __all__ = [
@@ -83,7 +83,6 @@ __all__ = [
     "PolyFFC",
     "PolyFile",
     "WideInput",
-    "atomic_write_text",
     "coarse_search",
     "dumps_json",
     "count_overflows",
@@ -178,9 +177,22 @@ class PolyFile:
     polynomials: dict[str, list[float]]
 
 
+#: Largest image side the conversion accepts (the maps' limit), and the largest |fl| of a quantizer.
+MAX_SIDE = 16384
+MAX_PIXELS = 1 << 24
+MAX_FRACTION_BITS = 256
+
+
+def _check_pixels(width: int, height: int) -> None:
+    if width * height > MAX_PIXELS:
+        raise FFCError(f"{width}x{height} has {width * height} pixels; at most {MAX_PIXELS} (e.g. 4096x4096)")
+
+
 def _check_size(name: str, v: Any) -> int:
     if isinstance(v, bool) or not isinstance(v, numbers.Integral) or int(v) < 1:
         raise FFCError(f"{name} must be a positive integer, got {v!r}")
+    if int(v) > MAX_SIDE:
+        raise FFCError(f"{name} {v} is implausible (at most {MAX_SIDE} pixels)")
     return int(v)
 
 
@@ -205,7 +217,7 @@ def read_poly_json(path: str | os.PathLike[str]) -> PolyFile:
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
-        raise FFCError(f"{path}: no such file") from None
+        raise FFCError(f"file {path} does not exist") from None
     except OSError as exc:
         raise FFCError(f"{path}: cannot read: {exc.strerror or exc}") from None
     try:
@@ -217,8 +229,12 @@ def read_poly_json(path: str | os.PathLike[str]) -> PolyFile:
     for key in ("width", "height", "degree", "polynomials"):
         if key not in data:
             raise FFCError(f"{path}: missing key {key!r}")
-    width = _check_size("width", data["width"])
-    height = _check_size("height", data["height"])
+    try:
+        width = _check_size("width", data["width"])
+        height = _check_size("height", data["height"])
+        _check_pixels(width, height)
+    except FFCError as exc:
+        raise FFCError(f"{path}: {exc}") from None
     if data["degree"] != DEGREE or isinstance(data["degree"], bool):
         raise FFCError(f"{path}: the FFC handles degree-3 polynomials only, got degree {data['degree']!r}")
     if "terms" in data and list(data["terms"]) != list(TERMS):
@@ -994,8 +1010,13 @@ def run_ffc(polys: Mapping[str, Sequence[float]], width: int, height: int, max_e
         return ffc_polynomial(item[1], width, height, bound, m, L, H, name=item[0])
 
     if workers > 1 and len(polys) > 1:
-        with ThreadPoolExecutor(max_workers=workers) as pool:
+        pool = ThreadPoolExecutor(max_workers=workers)
+        try:
             results = list(pool.map(one, polys.items()))
+        except BaseException:  # an error or a signal: drop the queued polynomials, do not wait for them
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
+        pool.shutdown()
     else:
         results = [one(it) for it in polys.items()]
     per = {r.name: r for r in results}
@@ -1030,24 +1051,6 @@ def run_ffc(polys: Mapping[str, Sequence[float]], width: int, height: int, max_e
 
 # ---------------------------------------------------------------------------
 # output: quantizers.json
-
-
-def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
-    """Write ``text`` to ``path`` via a temporary file in the same folder and ``os.replace``."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent or Path("."))
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
 
 
 def _fmt_json(q: int, f: Fmt, **extra: Any) -> dict[str, Any]:
@@ -1117,7 +1120,7 @@ def read_quantizers_json(path: str | os.PathLike[str]) -> dict[str, Any]:
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
-        raise FFCError(f"{path}: no such file") from None
+        raise FFCError(f"file {path} does not exist") from None
     except OSError as exc:
         raise FFCError(f"{path}: cannot read: {exc.strerror or exc}") from None
     except json.JSONDecodeError as exc:
@@ -1127,8 +1130,10 @@ def read_quantizers_json(path: str | os.PathLike[str]) -> dict[str, Any]:
     for key in ("width", "height", "degree", "quantizers", "polynomials"):
         if key not in doc:
             raise FFCError(f"{path}: missing key {key!r}")
-    _check_size("width", doc["width"])
-    _check_size("height", doc["height"])
+    try:
+        _check_pixels(_check_size("width", doc["width"]), _check_size("height", doc["height"]))
+    except FFCError as exc:
+        raise FFCError(f"{path}: {exc}") from None
     if doc["degree"] != DEGREE:
         raise FFCError(f"{path}: degree must be {DEGREE}, got {doc['degree']!r}")
     qs = doc["quantizers"]
@@ -1144,12 +1149,22 @@ def read_quantizers_json(path: str | os.PathLike[str]) -> dict[str, Any]:
             for k in ("wl", "fl"):
                 if isinstance(q.get(k), bool) or not isinstance(q.get(k), int):
                     raise ValueError(f"'{k}' must be an integer")
+            if not 1 <= q["wl"] <= MAX_ARRAY_WL:
+                raise ValueError(f"word length {q['wl']} is implausible (the conversion makes 1..{MAX_ARRAY_WL} bits)")
+            if abs(q["fl"]) > MAX_FRACTION_BITS:
+                raise ValueError(f"fraction length {q['fl']} is implausible (|fl| <= {MAX_FRACTION_BITS})")
             fmts.append(Fmt(q["signed"], q["wl"], q["fl"]))
         except ValueError as exc:
             raise FFCError(f"{path}: quantizer q{i}: {exc}") from None
     polys = doc["polynomials"]
     if not isinstance(polys, dict) or not polys:
         raise FFCError(f"{path}: 'polynomials' must be a non-empty object")
+    if sorted(polys) != sorted(POLY_NAMES):
+        missing = [n for n in POLY_NAMES if n not in polys]
+        extra = [n for n in polys if n not in POLY_NAMES]
+        what = (f"lacks {', '.join(missing)}" if missing else "") + ("; " if missing and extra else "") + \
+            (f"has unknown {', '.join(map(str, extra))}" if extra else "")
+        raise FFCError(f"{path}: 'polynomials' must hold the four {', '.join(POLY_NAMES)}; it {what}")
     for name, entry in polys.items():
         codes = entry.get("codes") if isinstance(entry, dict) else None
         if not isinstance(codes, list) or len(codes) != 10 or \

@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from eyestereo.tools.rectify.calib import atomic_output
+from eyestereo.tools.io import atomic_output
 from eyestereo.tools.rectify.maps import MAP_KEYS, Maps
 
 __all__ = ["INT16_INVALID", "create_c_lut", "lut_codes"]
@@ -54,8 +54,11 @@ def _guard(path: Path) -> str:
 
 
 def create_c_lut(maps: Maps, path: str | os.PathLike[str], *, frac_bits: int = 5,
-                 prefix: str = "eyestereo_lut") -> None:
-    """Write the four backward tables of ``maps`` as a C header (format in the module docstring). Atomic."""
+                 prefix: str = "eyestereo_lut", guard: str | None = None) -> None:
+    """Write the four backward tables of ``maps`` as a C header (format in the module docstring). Atomic.
+
+    ``guard``: the file name the include guard is made from (default: ``path``'s name; give the final
+    name when ``path`` is a temporary)."""
     if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", prefix):
         raise ValueError(f"prefix must be a C identifier, got {prefix!r}")
     if not 0 <= frac_bits <= 14:
@@ -65,12 +68,13 @@ def create_c_lut(maps: Maps, path: str | os.PathLike[str], *, frac_bits: int = 5
         raise ValueError(f"{src_w}x{src_h} images need coordinates beyond int16 with {frac_bits} "
                          f"fraction bits; use fewer")
     p = Path(path)
+    g = Path(guard) if guard is not None else p
     P = prefix.upper()
     lines = [
         f"/* Backward rectification look-up tables, written by eyestereo (Rectification Toolbox). */",
         f"/* entry [y * {P}_WIDTH + x] = source coordinate * 2^{P}_FRAC_BITS, 0-based pixels. */",
-        f"#ifndef {_guard(p)}",
-        f"#define {_guard(p)}",
+        f"#ifndef {_guard(g)}",
+        f"#define {_guard(g)}",
         "#include <stdint.h>",
         f"#define {P}_WIDTH {maps.width}",
         f"#define {P}_HEIGHT {maps.height}",
@@ -85,7 +89,7 @@ def create_c_lut(maps: Maps, path: str | os.PathLike[str], *, frac_bits: int = 5
         for i in range(0, len(codes), 16):
             lines.append("  " + ",".join(str(c) for c in codes[i:i + 16]) + ",")
         lines.append("};")
-    lines.append(f"#endif /* {_guard(p)} */")
+    lines.append(f"#endif /* {_guard(g)} */")
     text = "\n".join(lines) + "\n"
     with atomic_output(p, suffix=".h") as tmp:
         tmp.write_text(text, encoding="ascii")

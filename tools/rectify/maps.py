@@ -58,7 +58,8 @@ from typing import TYPE_CHECKING, Any
 import cv2
 import numpy as np
 
-from eyestereo.tools.rectify.calib import StereoCalibration, atomic_output
+from eyestereo.tools.io import atomic_output
+from eyestereo.tools.rectify.calib import StereoCalibration
 
 if TYPE_CHECKING:
     from eyestereo.tools.rectify.rig import StereoRig
@@ -90,6 +91,10 @@ MAP_KEYS = ("left_x", "left_y", "right_x", "right_y")
 
 # --------------------------------------------------------------------------------------------------
 # Lens model
+
+
+#: Most pixels a rectified image may have (the maps hold several float64 arrays of that size).
+MAX_PIXELS = 1 << 24
 
 
 def _dist_coeffs(d: np.ndarray) -> np.ndarray:
@@ -200,6 +205,9 @@ def _parse_size(size: tuple[int, int] | None, calib: StereoCalibration) -> tuple
     w, h = (int(v) for v in size)
     if w < 1 or h < 1 or w > 16384 or h > 16384:
         raise ValueError(f"rectified size must be 1..16384 pixels per side, got {w}x{h}")
+    if w * h > MAX_PIXELS:
+        raise ValueError(f"rectified size {w}x{h} has {w * h} pixels; at most {MAX_PIXELS} (e.g. 4096x4096) fit "
+                         "the maps in memory")
     return w, h
 
 

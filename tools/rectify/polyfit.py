@@ -37,8 +37,8 @@ from typing import Any
 
 import numpy as np
 
-from eyestereo.tools.rectify.calib import atomic_output
-from eyestereo.tools.progress import Progress
+from eyestereo.tools.io import atomic_output
+from eyestereo.tools.progress import progress_bar
 from eyestereo.tools.rectify.maps import MAP_KEYS, Maps
 
 __all__ = [
@@ -264,6 +264,10 @@ def poly_from_dict(doc: Any, name: str = "poly.json") -> Fit:
         v = doc[key]
         if not isinstance(v, int) or isinstance(v, bool) or v < 1:
             raise ValueError(f"{name}: '{key}' must be a positive integer, got {v!r}")
+        if v > 16384:
+            raise ValueError(f"{name}: '{key}' {v} is implausible (at most 16384 pixels)")
+    if doc["width"] * doc["height"] > 1 << 24:
+        raise ValueError(f"{name}: {doc['width']}x{doc['height']} is implausible (at most {1 << 24} pixels)")
     degree = doc["degree"]
     if not isinstance(degree, int) or isinstance(degree, bool) or degree not in DEGREES:
         raise ValueError(f"{name}: 'degree' must be 2, 3 or 4, got {degree!r}")
@@ -313,7 +317,8 @@ def plot_errors(maps: Maps, result: Fit, folder: str | os.PathLike[str], *, step
         raise ValueError(f"maps are {maps.width}x{maps.height} but the fit is {result.width}x{result.height}")
     written = []
     h, w = maps.height, maps.width
-    bar = Progress(4, "error plots")
+    step = max(1, min(step, w, h))  # a small map still gets one arrow per cell
+    bar = progress_bar(4, "error plots")
     for side in ("left", "right"):
         mx, my = maps.side(side)
         ex = result.evaluate(f"{side}_x") - mx

@@ -30,8 +30,9 @@ from typing import Any
 import cv2
 import numpy as np
 
-from eyestereo.tools.rectify.calib import StereoCalibration, atomic_write_bytes, board_object_points, write_yaml
-from eyestereo.tools.progress import Progress
+from eyestereo.tools.io import Outputs
+from eyestereo.tools.rectify.calib import StereoCalibration, board_object_points, write_yaml
+from eyestereo.tools.progress import progress_bar
 
 __all__ = [
     "BOARD",
@@ -331,7 +332,7 @@ def render_views(rig: StereoRig | None = None, n: int = 10, *, seed: int = 0, bo
     obj = board_object_points(board, square).astype(np.float64)
     out = RenderedViews([], [], poses, [], [], tuple(board), float(square))
     size = (rig.width, rig.height)
-    with Progress(n, "rendering views", force=progress) as bar:
+    with progress_bar(n, "rendering views", force=progress) as bar:
         for rvec, tvec in poses:
             rv2, tv2 = _right_pose(rig, rvec, tvec)
             out.left.append(_render((rig.M1, rig.D1), rvec, tvec, size, board, square, supersample, rng, blur, noise,
@@ -344,35 +345,33 @@ def render_views(rig: StereoRig | None = None, n: int = 10, *, seed: int = 0, bo
     return out
 
 
+#: Names :func:`write_rig` writes into its folder (an existing folder may hold only these).
+RIG_FILES = r"(left|right)\d{2,}\.png|rig_calib\.yml"
+
+
 def write_rig(folder: str | os.PathLike[str], rig: StereoRig | None = None, n: int = 10, *, seed: int = 0,
               layout: str = "random", progress: bool | None = None) -> list[Path]:
     """Write ``left01.png``.. / ``right01.png``.. and the rig's true calibration ``rig_calib.yml``.
 
-    ``folder`` is created (not its parents) after the views are rendered. Returns the written paths.
-    Each file is written atomically.
+    ``folder`` is written all or nothing (:class:`eyestereo.tools.io.Outputs`): created if missing
+    (its parent must exist), or, if it exists, replaced as a whole, which it must allow by holding
+    nothing but an earlier rig's files (:data:`RIG_FILES`). Returns the written paths.
     """
     rig = eyebot_rig() if rig is None else rig
     folder = Path(folder)
-    if folder.exists() and not folder.is_dir():
-        raise ValueError(f"{folder} exists and is not a folder")
-    if not folder.parent.is_dir():
-        raise ValueError(f"cannot create {folder}: folder {folder.parent} does not exist")
-    views = render_views(rig, n, seed=seed, layout=layout, progress=progress)
-    encoded = []
-    for i, (a, b) in enumerate(zip(views.left, views.right), start=1):
-        for name, img in ((f"left{i:02d}.png", a), (f"right{i:02d}.png", b)):
-            ok, buf = cv2.imencode(".png", img)
-            if not ok:
-                raise ValueError(f"cannot encode {name}")
-            encoded.append((folder / name, buf.tobytes()))
-    folder.mkdir(exist_ok=True)  # only now that everything is rendered
-    written = []
-    for path, data in encoded:
-        atomic_write_bytes(path, data)
-        written.append(path)
-    calib_path = folder / "rig_calib.yml"
-    write_yaml(rig.calibration(), calib_path)
-    written.append(calib_path)
+    with Outputs() as out:
+        tmp = out.folder(folder, RIG_FILES)
+        views = render_views(rig, n, seed=seed, layout=layout, progress=progress)
+        written = []
+        for i, (a, b) in enumerate(zip(views.left, views.right), start=1):
+            for name, img in ((f"left{i:02d}.png", a), (f"right{i:02d}.png", b)):
+                ok, buf = cv2.imencode(".png", img)
+                if not ok:
+                    raise ValueError(f"cannot encode {name}")
+                (tmp / name).write_bytes(buf.tobytes())
+                written.append(folder / name)
+        write_yaml(rig.calibration(), tmp / "rig_calib.yml")
+        written.append(folder / "rig_calib.yml")
     return written
 
 

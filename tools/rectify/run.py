@@ -36,25 +36,24 @@ size. The rectified camera is then scaled as :func:`eyestereo.tools.rectify.maps
 describes (f with the height ratio, the principal point with the width and height ratios), so e.g.
 a 640x480 calibration rectified to 352x288 sees a slightly narrower horizontal field.
 
-**No half-written outputs.** Everything is built in a fresh hidden folder next to ``outdir``
-(``.OUTDIR.rectifier-XXXX``) and moved into place with one rename only when every step succeeded.
-An existing ``outdir`` is replaced as a whole, and only on success; to protect other files, an
-existing ``outdir`` must be empty or hold nothing but the outputs of an earlier run (checked before
-the run starts). A failed or interrupted run removes its hidden folder and leaves ``outdir`` as it
-was (absent, or untouched).
+**No half-written outputs** (the policy of :mod:`eyestereo.tools.io`). Everything is built in a
+fresh hidden folder next to ``outdir`` and moved into place with one rename only when every step
+succeeded. An existing ``outdir`` is replaced as a whole, and only on success; to protect other
+files, an existing ``outdir`` must be empty or hold nothing but the outputs of an earlier run
+(checked before the run starts). A failed or interrupted run removes its hidden folder and leaves
+``outdir`` as it was (absent, or untouched).
 """
 
 from __future__ import annotations
 
 import os
-import shutil
-import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from eyestereo.tools.progress import Progress
+from eyestereo.tools.io import Outputs, check_output_folder
+from eyestereo.tools.progress import progress_bar
 
 __all__ = ["OUTPUT_FILES", "PLOT_FILES", "REPORT_NAME", "run_all"]
 
@@ -66,57 +65,17 @@ REPORT_NAME = "report.txt"
 PACKAGE_NAME = "stereo_calibration_pkg"
 
 
-def _mode(kind: str) -> int:
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return (0o777 if kind == "dir" else 0o666) & ~mask
+def owned(name: str) -> bool:
+    """Whether ``name`` (relative to the output folder, ``/``-separated) is one the rectifier writes."""
+    if "/" in name:
+        folder, file = name.split("/", 1)
+        return folder == PLOT_DIR and file in PLOT_FILES
+    return name in OUTPUT_FILES or name == PLOT_DIR
 
 
 def _check_outdir(outdir: Path) -> None:
     """Refuse an output folder that cannot be (re)placed safely."""
-    if outdir.name in ("", ".", ".."):
-        raise ValueError(f"the output folder must be named, e.g. {Path(outdir, 'rectified')}; got {str(outdir)!r}")
-    parent = outdir.parent
-    if not parent.is_dir():
-        raise ValueError(f"cannot write {outdir}: folder {parent} does not exist")
-    if outdir.exists() or outdir.is_symlink():
-        if outdir.is_symlink() or not outdir.is_dir():
-            raise ValueError(f"{outdir} exists and is not a folder")
-        ours = set(OUTPUT_FILES) | {PLOT_DIR}
-        for p in sorted(outdir.iterdir()):
-            ok = p.name in ours and not p.is_symlink()
-            if ok and p.name == PLOT_DIR:
-                ok = p.is_dir() and all(q.name in PLOT_FILES and q.is_file() for q in p.iterdir())
-            elif ok:
-                ok = p.is_file()
-            if not ok:
-                raise ValueError(f"{outdir} holds {p.name}, which the rectifier did not write; "
-                                 f"give a new or empty folder (an existing one is replaced as a whole)")
-
-
-def _install(tmp: Path, outdir: Path) -> None:
-    """Move the finished folder ``tmp`` to ``outdir`` (replacing an earlier run's folder)."""
-    _check_outdir(outdir)  # again: the folder may have changed during the run
-    os.chmod(tmp, outdir.stat().st_mode & 0o777 if outdir.is_dir() else _mode("dir"))
-    if not outdir.exists():
-        os.rename(tmp, outdir)
-        return
-    old = Path(tempfile.mkdtemp(prefix=f".{outdir.name}.old-", dir=outdir.parent))
-    os.rmdir(old)
-    os.rename(outdir, old)
-    try:
-        os.rename(tmp, outdir)
-    except BaseException:
-        os.rename(old, outdir)
-        raise
-    shutil.rmtree(old, ignore_errors=True)
-
-
-def _normalise_modes(folder: Path) -> None:
-    """Files written through mkstemp are 0600; give every output the mode a plain file would get."""
-    fmode, dmode = _mode("file"), _mode("dir")
-    for p in folder.rglob("*"):
-        os.chmod(p, dmode if p.is_dir() else fmode)
+    check_output_folder(outdir, owned)
 
 
 def _table(report: dict[str, Any], degree: int, side: str) -> list[str]:
@@ -193,6 +152,7 @@ def run_all(calib_path: str | os.PathLike[str], outdir: str | os.PathLike[str], 
     per step and ``total``; ``report`` the text of ``report.txt``.
     """
     from eyestereo.tools.rectify.calib import read_yaml
+    from eyestereo.tools.rectify.judge import judge_calibration
     from eyestereo.tools.rectify.polyfit import DEGREES, fit, plot_errors, write_poly_json
     from eyestereo.tools.rectify.maps import compute_maps, save_maps
 
@@ -220,12 +180,11 @@ def run_all(calib_path: str | os.PathLike[str], outdir: str | os.PathLike[str], 
     t_start = time.perf_counter()
     timings: dict[str, float] = {}
     steps = ["read calib", "maps", "fit", "plots"] + (["ffc", "package"] if do_ffc else []) + ["report"]
-    tmp = Path(tempfile.mkdtemp(prefix=f".{outdir.name}.rectifier-", dir=outdir.parent))
-    try:
-        with Progress(len(steps), "rectifier", force=progress) as bar:
+    with Outputs() as out:
+        tmp = out.folder(outdir, owned)
+        with progress_bar(len(steps), "rectifier", force=progress) as bar:
             def step(name: str) -> float:
-                bar.label = f"rectifier: {name}"
-                bar.update(0)
+                bar.set_description(f"rectifier: {name}")
                 return time.perf_counter()
 
             def done(name: str, t0: float) -> None:
@@ -236,6 +195,7 @@ def run_all(calib_path: str | os.PathLike[str], outdir: str | os.PathLike[str], 
 
             t0 = step("read calib")
             cal = read_yaml(calib_path)
+            judge_calibration(cal, where=str(calib_path), allow_swapped=True)
             done("read calib", t0)
 
             t0 = step("maps")
@@ -280,10 +240,5 @@ def run_all(calib_path: str | os.PathLike[str], outdir: str | os.PathLike[str], 
             text = _report_text(info)
             (tmp / REPORT_NAME).write_text(text, encoding="utf-8")
             bar.update()
-            _normalise_modes(tmp)
-            _install(tmp, outdir)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
     return {"outdir": outdir, "files": files, "width": maps.width, "height": maps.height, "degree": degree,
             "table": poly.report, "ffc": result, "timings": timings, "report": text}

@@ -29,12 +29,12 @@ import re
 from pathlib import Path
 from typing import Any
 
+from eyestereo.tools.io import atomic_write_text
 from eyestereo.tools.rectify.ffc import (
     N_QUANTIZERS,
     QUANTIZER_EXPR,
     FFCError,
     FFCResult,
-    atomic_write_text,
     quantizers_dict,
     read_quantizers_json,
 )

@@ -2,8 +2,9 @@
 
 Runs :func:`eyestereo.tools.rectify.ffc.run_ffc` over every pixel of a 352x288 image (101,376 points, the
 four polynomials, coarse search + greedy tuning + merge) on realistic polynomials and writes the
-measured figures into the "Measured" section of ``docs/ffc.md`` (between the ``bench:begin`` and
-``bench:end`` markers; ``--no-write`` only prints them).
+measured figures into the "Measured" section of the page given by ``--out`` (``make bench``:
+``docs/ffc.md``; between the ``bench:begin`` and ``bench:end`` markers; without ``--out`` they are only
+printed).
 
 The polynomials come from a synthetic stereo rig like the thesis's (EyeBot M6, 352x288, f ~ 544 px):
 radial distortion k1 = -0.3, k2 = 0.08 in normalized coordinates, a small rectifying rotation per
@@ -25,7 +26,8 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
-from eyestereo.tools.rectify.ffc import POLY_NAMES, FFCResult, atomic_write_text, fixed_eval, float_eval, run_ffc
+from eyestereo.tools.io import atomic_write_text
+from eyestereo.tools.rectify.ffc import POLY_NAMES, FFCResult, fixed_eval, float_eval, run_ffc
 from eyestereo.tools.fixed import Fmt
 
 __all__ = ["TABLE_A2", "fit_poly3", "main", "rig_maps", "synthetic_rig_polynomials"]
@@ -233,14 +235,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--width", type=int, default=352)
     ap.add_argument("--height", type=int, default=288)
     ap.add_argument("--max-error", type=float, default=0.01)
-    ap.add_argument("--doc", type=Path, default=Path(__file__).resolve().parent.parent / "docs" / "ffc.md")
-    ap.add_argument("--no-write", action="store_true", help="only print the results")
+    ap.add_argument("--out", "--doc", dest="out", type=Path, default=None,
+                    help="page whose bench section is replaced (e.g. docs/ffc.md); without it: print only")
     args = ap.parse_args(argv)
     text, _ = run_bench(args.width, args.height, args.max_error)
-    sys.stdout.write(text)
-    if not args.no_write:
-        write_section(args.doc, text)
-        print(f"written to {args.doc}")
+    if args.out is None:
+        sys.stdout.write(text)
+    else:
+        write_section(args.out, text)
+        print(f"-> {args.out}")
     return 0
 
 

@@ -1,5 +1,14 @@
 """``python -m eyestereo.tools.reports.harris_report``: how the bit-true Harris compares, written to docs/harris.md.
 
+::
+
+    python -m eyestereo.tools.reports.harris_report --out docs/harris.md \
+        --image Tsukuba=tests/data/tsukuba_im3.png --image "chessboard left01=tests/data/chessboard_left01.jpg" \
+        --image Venus=../shared/data/middlebury/venus/im2.png
+
+(``make bench`` passes these.) Images whose file is missing are left out and said so; the centre
+352x288 of each is used.
+
 Figures (all measured here, on the bit-true model, which the GHDL regressions show equal to the VHDL):
 agreement with the float64 reference at the same k and threshold on real images, OpenCV's cornerHarris
 as a third opinion, localization on the synthetic test patterns, and the worst-case inputs.
@@ -15,20 +24,18 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from eyestereo.tools.io import atomic_write_text, read_image, to_grey8
 from eyestereo.tools.models import cornerness as cm
 from eyestereo.tools.models import harris_mono as hm
 from eyestereo.tools.testpattern import checkerboard_pattern, corner_pattern, match_corners
 
-ROOT = Path(__file__).resolve().parent.parent
-DATA = ROOT / "tests" / "data"
-SHARED = ROOT.parent / "shared" / "data"
 W, H = 352, 288
 
 
 def load(path: Path) -> np.ndarray:
-    img = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
-    if img is None:
-        raise FileNotFoundError(f"cannot read {path}")
+    img = to_grey8(read_image(path, grey=True), f"image {path}")
+    if img.shape[0] < H or img.shape[1] < W:
+        raise ValueError(f"image {path} is smaller than {W}x{H}")
     y0, x0 = (img.shape[0] - H) // 2, (img.shape[1] - W) // 2
     return img[y0:y0 + H, x0:x0 + W].astype(np.int64)
 
@@ -136,15 +143,29 @@ def worst_cases() -> list[str]:
     return rows
 
 
+def _named(text: str) -> tuple[str, Path]:
+    name, sep, path = text.partition("=")
+    if not sep or not name.strip() or not path:
+        raise argparse.ArgumentTypeError(f"expected NAME=PATH, got {text!r}")
+    return name.strip(), Path(path)
+
+
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description="Harris accuracy figures to docs/harris.md")
-    ap.add_argument("--out", type=Path, default=ROOT / "docs" / "harris.md")
+    ap = argparse.ArgumentParser(prog="python -m eyestereo.tools.reports.harris_report",
+                                 description="Harris accuracy figures to a Markdown page")
+    ap.add_argument("--out", type=Path, required=True, help="page to write (e.g. docs/harris.md)")
+    ap.add_argument("--image", type=_named, action="append", required=True, metavar="NAME=PATH",
+                    help="a real image to measure on (repeat; missing files are left out and said so)")
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
-    images = {"Tsukuba": load(DATA / "tsukuba_im3.png"), "chessboard left01": load(DATA / "chessboard_left01.jpg")}
-    venus = SHARED / "middlebury" / "venus" / "im2.png"
-    if venus.exists():
-        images["Venus"] = load(venus)
+    images = {}
+    for name, path in args.image:
+        if path.is_file():
+            images[name] = load(path)
+        else:
+            print(f"note: {path} not found, {name} left out", file=sys.stderr)
+    if not images:
+        ap.error("none of the --image files exists")
     text = ["# Harris corner detector: accuracy of the bit-true design", "",
             f"Made by `python -m eyestereo.tools.reports.harris_report` ({time.strftime('%Y-%m-%d')}). The bit-true "
             "model equals the VHDL bit for bit (tests/test_harris_sim.py), so these are the hardware's figures.",
@@ -168,9 +189,8 @@ def main(argv=None) -> int:
              "only on the negative side (edges), never for corners.", ""]
     text += worst_cases()
     text += ["", f"Report computed in {time.perf_counter() - t0:.1f} s."]
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text("\n".join(text) + "\n")
-    print("\n".join(text))
+    atomic_write_text(args.out, "\n".join(text) + "\n")
+    print(f"-> {args.out} ({time.perf_counter() - t0:.0f} s)")
     return 0
 
 
