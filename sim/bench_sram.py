@@ -191,9 +191,11 @@ def report(res: dict) -> str:
           "of the cameras' async FIFOs), the rectifier's pixel fetch port (slave side, `hdl/fetch_port.py`), the "
           "rectified-image writer (the stereo image stream, left and right pixel of each (x, y) packed into one "
           "word), the feature-list writer (queue read port) and the host port (reads and writes, byte "
-          "enables). Writers collect bursts of 8 words in LUT-RAM FIFOs; cameras are urgent (served first), the "
-          "rest round robin with bursts; per-master counters of words moved and clocks waited, frame counters "
-          "and buffer states on a status port.",
+          "enables). Writers collect bursts of 8 words in LUT-RAM FIFOs. The writers of the streams that cannot "
+          "wait (both cameras, the rectified stream) are urgent and take turns first; the feature writer, the "
+          "fetch port and the host take turns round robin in the gaps; every turn moves at least one word, so "
+          "no master starves. Per-master counters of words moved and clocks waited, frame counters and buffer "
+          "states on a status port.",
           "- **Frame buffers** (`hdl/frame_buffers.py`): two buffers per producer, FREE / WRITING / FULL / READING; "
           "a frame is FULL once its last word is issued (the controller is in order), a consumer takes the "
           "newest FULL frame and holds it until it releases it, so nobody reads a half-written frame. The same "
@@ -246,8 +248,8 @@ def report(res: dict) -> str:
         L += ["## Camera margin", "",
               "Both cameras at the same word rate while the rectifier fetches without pause, the rectified "
               "writer runs and the host reads the rectified images at 12.5 M words/s; camera FIFO (the async "
-              "FIFO's read side) 1024 words. Cameras are served first, so their rate only takes bandwidth from "
-              "the rectifier. A rate is *sustained* when the cameras' words are written as fast as they come "
+              "FIFO's read side) 1024 words. Camera writers are urgent, so their rate takes bandwidth from the "
+              "rectifier and the host, not the other way round. A rate is *sustained* when the cameras' words are written as fast as they come "
               "and the FIFO stays nearly empty (at most 64 words): a FIFO that keeps filling overflows in a "
               "longer run.", "",
               "| part | camera rate (M words/s each) | x 9 M | max FIFO fill | sustained | cameras (words/clock) | "
@@ -325,10 +327,15 @@ def report(res: dict) -> str:
         for r in rs:
             s_ = r["summary"]
             fm = f"{r['ecp5_fmax']:.1f} MHz" if r.get("ecp5_fmax") else "-"
+            dev = r.get("ecp5_device", "")
+            dev = "LFE5U-85F CABGA756" if "85k" in dev else ("LFE5U-25F CABGA381" if dev else "")
             L.append(f"| {r['block']} | {s_['LUT']} | {s_['LUTRAM']} | {s_['FF']} | {s_['RAMB16']} | "
                      f"{s_['MULT18X18']} | {s_['carry']} | {r['levels']} | {r['period']} ns ({r['fmax']} MHz) | "
-                     f"{fm} | {r.get('ecp5_device', '')} |")
-        L.append("")
+                     f"{fm} | {dev} |")
+        L += ["", "The arbiter alone has its word port on pins as well (far-apart I/O on the 85k device), which "
+              "costs it in the place and route; inside the subsystem that port is internal. The 32-bit counters "
+              "(12 counters of words moved and clocks waited, and the clock counter) are about 230 of the "
+              "arbiter's LUTs (`counter_bits=16`: the row above).", ""]
     sp = res.get("speed")
     if sp:
         L += [f"Simulation speed (GHDL mcode, cocotb, the SRAM model and six agents in Python): about "
