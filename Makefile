@@ -80,6 +80,7 @@ bench: setup
 	$(PY) -m eyestereo.tools.reports.bench_matching --middlebury $(SHARED)/middlebury --out docs/matching.md \
 	  --img docs/img
 	$(PY) -m eyestereo.sim.bench_camera --out docs/camera.md
+	$(PY) -m eyestereo.sim.bench_sram --out docs/sram.md
 
 clean:
 	rm -rf build .pytest_cache .hypothesis
