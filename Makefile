@@ -80,8 +80,9 @@ bench: setup
 	$(PY) -m eyestereo.tools.reports.bench_matching --middlebury $(SHARED)/middlebury --out docs/matching.md \
 	  --img docs/img
 	$(PY) -m eyestereo.sim.bench_camera --out docs/camera.md
-	$(PY) -m eyestereo.tools.reports.rectifier_precision
-	$(PY) -m eyestereo.sim.bench_warper
+	$(PY) -m eyestereo.sim.bench_sram --out docs/sram.md
+	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.tools.reports.rectifier_precision
+	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.sim.bench_warper
 
 clean:
 	rm -rf build .pytest_cache .hypothesis

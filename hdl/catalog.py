@@ -31,6 +31,12 @@ from eyestereo.hdl.poly_unit import CoefPort, poly_unit
 from eyestereo.hdl.sobel import sobel
 from eyestereo.hdl.stream_checker import stream_checker
 from eyestereo.hdl.queue import QueuePort
+from eyestereo.hdl.fetch_port import FetchPort
+from eyestereo.hdl.frame_buffers import BufferSide, FrameControl, double_buffer
+from eyestereo.hdl.sram_arbiter import TAG_BITS, sram_arbiter
+from eyestereo.hdl.sram_bus import HostPort, SramCmd, SramPins, SramRsp, StatPort
+from eyestereo.hdl.sram_controller import sram_controller
+from eyestereo.hdl.sram_subsystem import sram_subsystem
 from eyestereo.hdl.stream import ImageStream
 from eyestereo.tools.camera import WORD as CAMERA_WORD
 from eyestereo.hdl.stream_to_axis import stream_to_axis
@@ -276,6 +282,46 @@ BLOCKS: dict[str, BlockSpec] = {
         hw_params=("width", "height"), sink_type=AxiStream,
         control=(("error", lambda p: Signal(bool(0))),)),
 }
+
+
+# --- the SRAM subsystem (issue 12): blocks with interfaces of their own, ports made by ``build`` --------
+def _clk_rst():
+    return dict(clk=Signal(bool(0)), rst=_rst())
+
+
+def _build_sram_controller(p):
+    return dict(_clk_rst(), cmd=SramCmd(tag_bits=p["tag_bits"]), rsp=SramRsp(tag_bits=p["tag_bits"]),
+                sram=SramPins())
+
+
+def _masters(p):
+    return dict(cam0=QueuePort(CAMERA_WORD), cam1=QueuePort(CAMERA_WORD), fetch=FetchPort(p["width"], p["height"]),
+                rect=ImageStream(8, stereo=True), feat=QueuePort(16), host=HostPort(), ctl=FrameControl(),
+                stat=StatPort())
+
+
+_ARB = dict(width=352, height=288, feature_words=8192, depth=16, burst=8, fetch_burst=8, host_burst=1,
+            counter_bits=32)
+
+BLOCKS["sram_controller"] = BlockSpec(
+    "sram_controller", "1M x 16 synchronous SRAM (NoBL or pipelined SyncBurst): pins <-> in-order word port",
+    sram_controller, dict(kind="nobl", read_latency=2, tag_bits=5), sink_width=lambda p: 16,
+    source_width=lambda p: 16, hw_params=("kind", "read_latency"), build=_build_sram_controller,
+    clocks=(("clk", 100.0),))
+BLOCKS["double_buffer"] = BlockSpec(
+    "double_buffer", "frame handshake of one producer's two SRAM buffers (FREE/WRITING/FULL/READING)",
+    double_buffer, dict(), sink_width=lambda p: 1, source_width=lambda p: 1,
+    build=lambda p: dict(_clk_rst(), side=BufferSide()), clocks=(("clk", 100.0),))
+BLOCKS["sram_arbiter"] = BlockSpec(
+    "sram_arbiter", "six SRAM masters (2 cameras, fetch port, rectified, features, host), double buffers",
+    sram_arbiter, dict(_ARB), sink_width=lambda p: 16, source_width=lambda p: 8, hw_params=tuple(_ARB),
+    build=lambda p: dict(_clk_rst(), **_masters(p), cmd=SramCmd(tag_bits=TAG_BITS), rsp=SramRsp(tag_bits=TAG_BITS)),
+    clocks=(("clk", 100.0),))
+BLOCKS["sram_subsystem"] = BlockSpec(
+    "sram_subsystem", "sram_arbiter + sram_controller: the SRAM's pins and the six masters' ports",
+    sram_subsystem, dict(_ARB, kind="nobl", read_latency=2), sink_width=lambda p: 16, source_width=lambda p: 8,
+    hw_params=tuple(_ARB) + ("kind", "read_latency"), build=lambda p: dict(_clk_rst(), **_masters(p), sram=SramPins()),
+    clocks=(("clk", 100.0),))
 
 
 #: Simulation-only top levels (a bench harness around a block, registered by its module in

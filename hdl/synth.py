@@ -82,6 +82,16 @@ VARIANTS = [
 
 #: nextpnr-ecp5 target: the smallest ECP5 with as many multipliers and more block RAM than the Spartan-3E 500.
 ECP5 = ("--25k", "--package", "CABGA381", "--speed", "6")
+#: Blocks with more port bits than that package has I/O pins (197; the SRAM arbiter with its six masters'
+#: ports) are placed on the largest package instead, same speed grade: the figure is then for that device.
+ECP5_WIDE = ("--85k", "--package", "CABGA756", "--speed", "6")
+ECP5_IOS = 197
+
+
+def _port_bits(netlist_json: Path, top: str) -> int:
+    """Port bits of ``top`` in a Yosys JSON netlist."""
+    mod = json.loads(Path(netlist_json).read_text())["modules"][top]
+    return sum(len(p["bits"]) for p in mod["ports"].values())
 
 DOC_BEGIN, DOC_END = "<!-- synth:begin -->", "<!-- synth:end -->"
 
@@ -220,7 +230,8 @@ def ecp5(job: dict, *, freq: float = 100.0, seed: int = 1) -> dict:
     clocks = list(job["clocks"])
     (d / "ecp5.lpf").write_text("".join(f'FREQUENCY PORT "{c}" {freq:.1f} MHz;\n' for c in clocks))
     t0 = time.perf_counter()
-    cmd = nextpnr_command() + list(ECP5) + [
+    device = ECP5 if _port_bits(d / "ecp5.json", job["block"]) <= ECP5_IOS else ECP5_WIDE
+    cmd = nextpnr_command() + list(device) + [
         "--json", "ecp5.json", "--lpf", "ecp5.lpf", "--lpf-allow-unconstrained", "--timing-allow-fail",
         "--seed", str(seed), "--report", "pnr_report.json", "--log", "nextpnr.log", "-q"]
     r = subprocess.run(cmd, cwd=d, capture_output=True, text=True)
@@ -232,7 +243,10 @@ def ecp5(job: dict, *, freq: float = 100.0, seed: int = 1) -> dict:
         if c not in fmax:
             fmax[c] = dict(achieved=None, constraint=freq, net=None)  # clock drives no register-to-register path
     util = {k: v["used"] for k, v in rep.get("utilization", {}).items() if v.get("used")}
-    return dict(fmax=fmax, ecp5=util, pnr_seconds=round(time.perf_counter() - t0, 1))
+    out = dict(fmax=fmax, ecp5=util, pnr_seconds=round(time.perf_counter() - t0, 1))
+    if device != ECP5:
+        out["ecp5_device"] = " ".join(device)
+    return out
 
 
 def synth_block(name: str, out: Path, *, label: str | None = None, pnr: bool = False, freq: float = 100.0,
