@@ -35,7 +35,7 @@ import eyestereo.sim.warper_harness  # noqa: F401  (registers the bench top)
 from eyestereo.hdl import synth
 from eyestereo.sim.runner import BUILD, ROOT, run_bench, slug
 from eyestereo.tools.rectify import calibrations
-from eyestereo.tools.rectify.ffc import atomic_write_text
+from eyestereo.tools.io import atomic_write_text
 
 TOP = "coordinate_warper_tb"
 BEGIN, END = "<!-- warper-bench:begin -->", "<!-- warper-bench:end -->"

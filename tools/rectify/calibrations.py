@@ -6,7 +6,7 @@ merged formats and the ten coefficient codes of each polynomial. :func:`load` tu
 into such a document (checked by :func:`~eyestereo.tools.rectify.ffc.read_quantizers_json`):
 
 ``"rig"`` (the default)
-    The synthetic rig of the FFC benchmark (:func:`eyestereo.tools.reports.bench_ffc.synthetic_rig_polynomials`,
+    The synthetic rig of the FFC benchmark (:func:`eyestereo.tools.rectify.synthetic_rig.synthetic_rig_polynomials`,
     352x288, k1 about -0.3, about 1 degree of misalignment), converted with the default bound
     (mse 0.01 px^2 per polynomial). The repository rebuilds it from nothing in a few seconds.
 ``"rig:WxH"``
@@ -47,10 +47,10 @@ from typing import Any
 
 import numpy as np
 
+from eyestereo.tools.io import atomic_write_text
 from eyestereo.tools.rectify.ffc import (
     POLY_NAMES,
     FFCError,
-    atomic_write_text,
     dumps_json,
     quantizers_dict,
     read_quantizers_json,
@@ -154,7 +154,7 @@ def _polynomials(kind: str, args: dict[str, Any]) -> tuple[dict[str, list[float]
     from eyestereo.tools.rectify.polyfit import fit
 
     if kind == "rig":
-        from eyestereo.tools.reports.bench_ffc import synthetic_rig_polynomials
+        from eyestereo.tools.rectify.synthetic_rig import synthetic_rig_polynomials
 
         w, h = args["width"], args["height"]
         return synthetic_rig_polynomials(w, h), w, h, w, h

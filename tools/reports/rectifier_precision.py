@@ -37,7 +37,8 @@ import numpy.typing as npt
 
 from eyestereo.tools.models import poly_unit as unit
 from eyestereo.tools.rectify import calibrations
-from eyestereo.tools.rectify.ffc import POLY_NAMES, atomic_write_text, float_eval
+from eyestereo.tools.io import atomic_write_text
+from eyestereo.tools.rectify.ffc import POLY_NAMES, float_eval
 from eyestereo.tools.rectify.warp import imwarp
 
 __all__ = ["FRACS", "choose_frac", "interpolate", "main", "study"]
