@@ -81,6 +81,8 @@ bench: setup
 	  --img docs/img
 	$(PY) -m eyestereo.sim.bench_camera --out docs/camera.md
 	$(PY) -m eyestereo.sim.bench_sram --out docs/sram.md
+	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.tools.reports.rectifier_precision
+	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.sim.bench_warper
 
 clean:
 	rm -rf build .pytest_cache .hypothesis

@@ -24,7 +24,10 @@ from eyestereo.hdl.harris_mono import harris_mono
 from eyestereo.hdl.harris_window import harris_window
 from eyestereo.hdl.nms import nms
 from eyestereo.hdl.prethreshold import prethreshold
+from eyestereo.hdl.coord_pair import CoordPair
+from eyestereo.hdl.coordinate_warper import coordinate_warper
 from eyestereo.hdl.line_delay import line_delay
+from eyestereo.hdl.poly_unit import CoefPort, poly_unit
 from eyestereo.hdl.sobel import sobel
 from eyestereo.hdl.stream_checker import stream_checker
 from eyestereo.hdl.queue import QueuePort
@@ -43,6 +46,7 @@ from eyestereo.tools.models import nms as nms_model
 from eyestereo.tools.models import sobel as sobel_model
 from eyestereo.tools.models import stream_checker as checker_model
 from eyestereo.tools.models.convolve import check_kernel, output_width
+from eyestereo.tools.models import poly_unit as poly_model
 
 
 @dataclass(frozen=True)
@@ -51,8 +55,8 @@ class BlockSpec:
     summary: str
     func: Callable
     defaults: dict
-    sink_width: Callable[[dict], int]
-    source_width: Callable[[dict], int]
+    sink_width: Callable[[dict], int] | None = None
+    source_width: Callable[[dict], int] | None = None
     hw_params: tuple[str, ...] = field(default=())  # parameters passed to the block function
     #: control ports after ``source``, in order: name -> function(params) -> fresh Signal
     control: tuple[tuple[str, Callable[[dict], object]], ...] = field(default=())
@@ -156,6 +160,40 @@ def _build_camera_pair(p):
     return ports
 
 
+#: Rectification blocks: ``quantizers`` is a calibration spec or a quantizers.json path
+#: (:func:`eyestereo.tools.rectify.calibrations.load`; "rig" = the synthetic rig, 352x288).
+_POLY_DEFAULTS = dict(quantizers="rig", frac=poly_model.DEFAULT_FRAC, source_width=None, source_height=None,
+                      coefficients="constant")
+
+
+def _calibration(p):
+    from eyestereo.hdl.poly_unit import calibration_param
+
+    return calibration_param(p["quantizers"], p["source_width"], p["source_height"])
+
+
+def _coef_port(p, cal):
+    if p["coefficients"] not in ("constant", "register"):
+        raise ValueError(f"parameter coefficients must be 'constant' or 'register', got {p['coefficients']!r}")
+    return {"coef": CoefPort(poly_model.coef_data_bits(cal.formats))} if p["coefficients"] == "register" else {}
+
+
+def _build_poly_unit(p):
+    cal = _calibration(p)
+    nb = poly_model.coord_bits(cal, p["frac"])
+    return dict(clk=Signal(bool(0)), rst=_rst(), enable=Signal(bool(0)), x=Signal(intbv(0)[poly_model.int_bits(cal.width):]),
+                y=Signal(intbv(0)[poly_model.int_bits(cal.height):]), select_coord=Signal(intbv(0)[3:]),
+                coord=Signal(intbv(0)[nb:]), out_of_range=Signal(bool(0)), select_coord_out=Signal(intbv(0)[3:]),
+                **_coef_port(p, cal))
+
+
+def _build_coordinate_warper(p):
+    cal = _calibration(p)
+    return dict(clk=Signal(bool(0)), rst=_rst(), start=Signal(bool(0)), enable=Signal(bool(0)), busy=Signal(bool(0)), done=Signal(bool(0)),
+                coord=CoordPair(cal.source_width, cal.source_height, poly_model.resolve_frac(cal, p["frac"])),
+                **_coef_port(p, cal))
+
+
 BLOCKS: dict[str, BlockSpec] = {
     "line_delay": BlockSpec(
         "line_delay", "one-line FIFO in block RAM: pixel (x, y-1) at (x, y)", line_delay,
@@ -190,6 +228,14 @@ BLOCKS: dict[str, BlockSpec] = {
         dict(width=352, height=288, size=3),
         sink_width=lambda p: corner_model.WORD.width, source_width=lambda p: nms_model.WORD.width,
         hw_params=("width", "height", "size")),
+    "poly_unit": BlockSpec(
+        "poly_unit", "the four rectification polynomials, 8-stage pipeline, 9 multipliers, 1 coordinate/clock",
+        poly_unit, _POLY_DEFAULTS,
+        hw_params=("quantizers", "frac", "source_width", "source_height"), build=_build_poly_unit),
+    "coordinate_warper": BlockSpec(
+        "coordinate_warper", "x/y counters, poly_unit and the double-buffered coordinate pair output (4 clocks/pair)",
+        coordinate_warper, _POLY_DEFAULTS,
+        hw_params=("quantizers", "frac", "source_width", "source_height"), build=_build_coordinate_warper),
     "harris_mono": BlockSpec(
         "harris_mono", "Harris corners: Sobel -> window -> cornerness -> pre-threshold -> NMS", harris_mono,
         dict(width=352, height=288, blocks=(4, 4), nms=3),
@@ -278,11 +324,17 @@ BLOCKS["sram_subsystem"] = BlockSpec(
     clocks=(("clk", 100.0),))
 
 
+#: Simulation-only top levels (a bench harness around a block, registered by its module in
+#: ``eyestereo.sim``): :func:`get` finds them, ``make vhdl`` / ``make synth`` do not build them.
+BENCH_TOPS: dict[str, BlockSpec] = {}
+
+
 def get(name: str) -> BlockSpec:
-    try:
+    if name in BLOCKS:
         return BLOCKS[name]
-    except KeyError:
-        raise ValueError(f"unknown block {name!r}; blocks are {sorted(BLOCKS)}") from None
+    if name in BENCH_TOPS:
+        return BENCH_TOPS[name]
+    raise ValueError(f"unknown block {name!r}; blocks are {sorted(BLOCKS)}")
 
 
 def jsonable(p: dict) -> dict:

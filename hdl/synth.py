@@ -47,7 +47,9 @@ from eyestereo.hdl.netlist import ghdl_netlist
 #: Thesis Tables 6.1/6.3 (Xilinx ISE, Spartan-3E 500): LUTs, block RAMs, multipliers.
 THESIS = {"sobel": (259, 2, 0), "harris_window": (843, 4, 3), "cornerness": (132, 0, 5),
           "prethreshold": (197, 0, 0), "prethreshold 1x1": (20, 0, 0), "nms": (381, 2, 0),
-          "nms 5x5": (706, 4, 0), "nms 1x1": (7, 0, 0)}
+          "nms 5x5": (706, 4, 0), "nms 1x1": (7, 0, 0),
+          # Table 4.4 (rectification): the calculation unit; the warper row adds its 99 LUTs to the unit's
+          "poly_unit": (262, 0, 9), "coordinate_warper": (361, 0, 9)}
 
 #: The thesis's clock goals (MHz) per block, for the default clock port ``clk``: the Harris detector and
 #: its parts run at 50 MHz (thesis 6.2.5; ISE reported 65 MHz), rectification, SRAM and the memory side

@@ -138,7 +138,9 @@ CORE = "core"
 #: What each part of tools may import from tools (``core`` = the top-level modules of eyestereo.tools).
 ALLOWED = {
     CORE: {CORE},
-    "models": {CORE, "models"},
+    # The rectification hardware's models are built on the toolbox's own bit-true evaluator
+    # (rectify.ffc.fixed_stages_codes): one definition of that arithmetic. rectify imports no model.
+    "models": {CORE, "models", "rectify"},
     "rectify": {CORE, "rectify"},
     "matching": {CORE, "models", "matching"},
     "cli": {CORE, "models", "rectify", "matching", "cli"},

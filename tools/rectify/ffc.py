@@ -89,6 +89,7 @@ __all__ = [
     "covers",
     "fixed_eval",
     "fixed_stages",
+    "fixed_stages_codes",
     "float_eval",
     "float_stages",
     "ffc_polynomial",
@@ -540,8 +541,29 @@ def fixed_stages(p: Sequence[float], formats: Sequence[Fmt], width: int, height:
     """Integer codes of every node q1..q26 (python ints for q1..q10, broadcastable int64 arrays else)."""
     p = _coeff_list(p)
     fmts = _check_formats(formats)
+    return fixed_stages_codes([_coef_code(p[i - 1], fmts[i - 1]) for i in range(1, 11)], fmts, width, height)
+
+
+def _check_codes(codes: Sequence[int], fmts: Sequence[Fmt]) -> list[int]:
+    codes = list(codes)
+    if len(codes) != 10:
+        raise FFCError(f"need the codes of p1..p10, got {len(codes)} codes")
+    out = []
+    for i, (c, f) in enumerate(zip(codes, fmts), 1):
+        if isinstance(c, (bool, np.bool_)) or not isinstance(c, numbers.Integral):
+            raise FFCError(f"code of p{i} must be an integer, got {c!r}")
+        if not f.contains(int(c)):
+            raise FFCError(f"code {int(c)} of p{i} does not fit q{i} {f}")
+        out.append(int(c))
+    return out
+
+
+def fixed_stages_codes(codes: Sequence[int], formats: Sequence[Fmt], width: int, height: int) -> dict[int, Any]:
+    """:func:`fixed_stages` from the coefficients' integer codes (q1..q10, as ``quantizers.json`` holds
+    them) instead of their real values: what the hardware calculation unit computes at every pixel."""
+    fmts = _check_formats(formats)
     xs, ys = _grid(width, height)
-    val: dict[int, Any] = {i: _coef_code(p[i - 1], fmts[i - 1]) for i in range(1, 11)}
+    val: dict[int, Any] = dict(enumerate(_check_codes(codes, fmts), 1))
     val[QX] = np.asarray(quantize(xs, fmts[QX - 1]), dtype=np.int64)
     val[QY] = np.asarray(quantize(ys, fmts[QY - 1]), dtype=np.int64)
     for q in _ORDER:
