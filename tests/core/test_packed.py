@@ -84,7 +84,7 @@ def test_hdl_pack_and_unpack_convert_and_agree(tmp_path):
 
     for hdl in ("VHDL", "Verilog"):
         roundtrip(Signal(intbv(0)[W.width:]), Signal(intbv(0)[W.width:])).convert(
-            hdl=hdl, path=str(tmp_path), name="roundtrip")
+            hdl=hdl, path=str(tmp_path), name="roundtrip", initial_values=False)  # MyHDL keeps the last setting
     for std in ("93c", "08"):
         r = subprocess.run(["ghdl", "-a", f"--std={std}", f"--workdir={tmp_path}",
                             str(tmp_path / "pck_myhdl_011.vhd"), str(tmp_path / "roundtrip.vhd")],
