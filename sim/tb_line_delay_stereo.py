@@ -52,7 +52,7 @@ async def line_delay_stereo_frames(dut):
     for i, (b, g, t) in enumerate(zip(beats, got, source.sent_cycles)):
         assert g[0] == t + 1, f"beat {i}: out in cycle {g[0]}, in at {t}: latency must be 1"
         assert (g[2], g[3], g[4]) == (int(b[1]), int(b[2]), int(b[3])), f"beat {i}: flags {g[2:5]} for {b[1:]}"
-        assert UNKNOWN not in (g[2], g[3], g[4])
+        assert UNKNOWN not in (g[1], g[2], g[3], g[4]), f"beat {i}: undefined bits {g[1:5]}"
     asm = [FrameAssembler(w, h), FrameAssembler(w, h)]
     for g in got:
         if g[3] and not g[2]:
