@@ -13,6 +13,7 @@ import numpy as np
 from myhdl import ResetSignal, Signal, intbv
 
 from eyestereo.hdl.async_fifo import async_fifo
+from eyestereo.hdl.axil import AxiLite
 from eyestereo.hdl.camera_bus import CameraBus
 from eyestereo.hdl.camera_interface import camera_interface, camera_pair
 from eyestereo.hdl.camera_stream import camera_stream
@@ -24,6 +25,7 @@ from eyestereo.hdl.harris_mono import harris_mono
 from eyestereo.hdl.harris_window import harris_window
 from eyestereo.hdl.nms import nms
 from eyestereo.hdl.prethreshold import prethreshold
+from eyestereo.hdl.register_bank import RegisterPorts, register_bank
 from eyestereo.hdl.coord_pair import CoordPair
 from eyestereo.hdl.coordinate_warper import coordinate_warper
 from eyestereo.hdl.line_delay import line_delay
@@ -323,6 +325,19 @@ BLOCKS["sram_subsystem"] = BlockSpec(
     hw_params=tuple(_ARB) + ("kind", "read_latency"), build=lambda p: dict(_clk_rst(), **_masters(p), sram=SramPins()),
     clocks=(("clk", 100.0),))
 
+
+# --- the complete system (issue 15): the register bank on the AXI4-Lite register bus ---------------------
+def _build_register_bank(p):
+    from eyestereo.tools.regmap import REGMAP
+
+    return dict(_clk_rst(), bus=AxiLite(REGMAP.addr_bits), regs=RegisterPorts(REGMAP), arb=StatPort(),
+                fcount=StatPort(5, 16), host=HostPort())
+
+
+BLOCKS["register_bank"] = BlockSpec(
+    "register_bank", "the register map (tools/regmap.py) on an AXI4-Lite slave: control, k, thresholds, status, "
+    "arbiter counters, SRAM window", register_bank, dict(width=352, height=288), sink_width=lambda p: 32,
+    source_width=lambda p: 32, hw_params=("width", "height"), build=_build_register_bank, clocks=(("clk", 100.0),))
 
 #: Simulation-only top levels (a bench harness around a block, registered by its module in
 #: ``eyestereo.sim``): :func:`get` finds them, ``make vhdl`` / ``make synth`` do not build them.
