@@ -40,6 +40,7 @@ from eyestereo.hdl.sram_bus import HostPort, SramCmd, SramPins, SramRsp, StatPor
 from eyestereo.hdl.sram_controller import sram_controller
 from eyestereo.hdl.sram_subsystem import sram_subsystem
 from eyestereo.hdl.stream import ImageStream
+from eyestereo.hdl.stream_cdc import stream_cdc
 from eyestereo.tools.camera import WORD as CAMERA_WORD
 from eyestereo.hdl.stream_to_axis import stream_to_axis
 from eyestereo.tools.models import cornerness as corner_model
@@ -338,6 +339,20 @@ BLOCKS["register_bank"] = BlockSpec(
     "register_bank", "the register map (tools/regmap.py) on an AXI4-Lite slave: control, k, thresholds, status, "
     "arbiter counters, SRAM window", register_bank, dict(width=352, height=288), sink_width=lambda p: 32,
     source_width=lambda p: 32, hw_params=("width", "height"), build=_build_register_bank, clocks=(("clk", 100.0),))
+
+
+def _build_stream_cdc(p):
+    return dict(wclk=Signal(bool(0)), wrst=_rst(), sink=ImageStream(p["data_width"], stereo=p["stereo"]),
+                rclk=Signal(bool(0)), rrst=_rst(), source=ImageStream(p["data_width"], stereo=p["stereo"]),
+                dropped=Signal(intbv(0)[16:]))
+
+
+BLOCKS["stream_cdc"] = BlockSpec(
+    "stream_cdc", "an image stream, mono or stereo, into another clock (async_fifo inside; whole stereo frames "
+    "or a reset token): the rectifier's stream into the Harris clock", stream_cdc,
+    dict(data_width=8, stereo=True, depth=16), sink_width=lambda p: p["data_width"],
+    source_width=lambda p: p["data_width"], hw_params=("depth",), build=_build_stream_cdc,
+    clocks=(("wclk", 100.0), ("rclk", 50.0)))
 
 #: Simulation-only top levels (a bench harness around a block, registered by its module in
 #: ``eyestereo.sim``): :func:`get` finds them, ``make vhdl`` / ``make synth`` do not build them.
