@@ -138,9 +138,17 @@ def rb_array(clk, rst, we, idx, wdata, wmask, word, p_we, p_addr, p_data, *, cou
     wd = Signal(intbv(0)[width:])
     pad = Signal(intbv(0)[32 - width:]) if width < 32 else None
 
+    valid = Signal(bool(0))
+
+    @always_seq(clk.posedge, reset=rst)
+    def flag():
+        # registered: the address is held for at least one clock before a write or a read's capture, and
+        # a flag register stops ABC from copying the 16:1 flag multiplexer into every data bit
+        valid.next = written[idx]
+
     @always_comb
     def read():
-        if written[idx]:
+        if valid:
             cur.next = mem[idx]
         else:
             cur.next = 0
@@ -167,7 +175,7 @@ def rb_array(clk, rst, we, idx, wdata, wmask, word, p_we, p_addr, p_data, *, cou
             p_addr.next = idx
             p_data.next = new
 
-    insts = [read, merge, merged, store, port]
+    insts = [flag, read, merge, merged, store, port]
     if pad is None:
         @always_comb
         def out():

@@ -59,3 +59,34 @@ def test_mono_stream_and_a_token(request):
     rep = _run(request, dict(wclk=[10000, 0], rclk=[20000, 1234], width=8, height=4, frames=3, duty=0.4,
                              tokens={1: 21}, seed=5), stereo=False)
     assert rep["frames"] == rep["sent"] == 2 and rep["tokens"] == 1
+
+
+# ---- elaboration checks ------------------------------------------------------------------------------
+from myhdl import Signal, intbv  # noqa: E402
+
+from eyestereo.hdl.catalog import BLOCKS  # noqa: E402
+from eyestereo.hdl.stream import ImageStream  # noqa: E402
+from eyestereo.hdl.stream_cdc import stream_cdc  # noqa: E402
+
+
+@pytest.mark.parametrize("over,kw,match", [
+    (dict(source=ImageStream(8)), {}, r"port source must be a stereo stream"),
+    (dict(source=ImageStream(9, stereo=True)), {}, r"port source must carry 8-bit data"),
+    (dict(sink=None), {}, r"port sink must be an ImageStream, got None"),
+    (dict(dropped=Signal(intbv(0)[8:])), {}, r"port dropped must be 16 bits wide"),
+    (dict(rclk=None), {}, r"port rclk must be a 1-bit Signal"),
+    ({}, dict(depth=12), r"parameter depth=12 must be a power of two"),
+    ({}, dict(depth=2), r"parameter depth=2 is too small"),
+])
+def test_stream_cdc_refuses(over, kw, match):
+    ports = BLOCKS["stream_cdc"].ports()[0]
+    ports.update(over)
+    with pytest.raises(ValueError, match=rf"^stream_cdc: {match}"):
+        stream_cdc(*ports.values(), **kw)
+
+
+def test_stream_cdc_source_needs_its_own_signals():
+    ports = BLOCKS["stream_cdc"].ports()[0]
+    ports["source"] = ports["sink"]
+    with pytest.raises(ValueError, match=r"^stream_cdc: ports source and sink share a signal"):
+        stream_cdc(*ports.values())
