@@ -90,3 +90,13 @@ def test_stream_cdc_source_needs_its_own_signals():
     ports["source"] = ports["sink"]
     with pytest.raises(ValueError, match=r"^stream_cdc: ports source and sink share a signal"):
         stream_cdc(*ports.values())
+
+
+@needs_ghdl
+@pytest.mark.sim
+def test_register_write_port_crosses_as_one_beat_frames(request):
+    """The threshold write port (4-bit index and 20-bit code) from the bus clock into the Harris clock:
+    each write a 1x1 frame of 24 bits; a write every 4 bus clocks at most (the bank's pace) never drops."""
+    rep = _run(request, dict(wclk=[10000, 0], rclk=[20000, 8900], width=1, height=1, frames=32, duty=0.25,
+                             seed=6), stereo=False, data_width=24)
+    assert rep["frames"] == rep["sent"] == 32 and rep["dropped"] == 0
