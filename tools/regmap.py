@@ -83,6 +83,8 @@ class Field:
     reset: int = 0
     param: str | None = None
     values: tuple[tuple[int, str], ...] = ()
+    #: where the field's port connects in the system top (documentation for whoever assembles it)
+    connect: str = ""
 
     @property
     def mask(self) -> int:
@@ -138,6 +140,14 @@ class Register:
         return self.offset + 4 * index
 
 
+_SEQ = "the system's sequencer (issue 15 item 2)"
+
+
+def _cell(text: str) -> str:
+    """Text for a Markdown table cell (a '|' would end the cell)."""
+    return str(text).replace("|", "\\|")
+
+
 def _f(name, lsb, width, doc, **kw) -> Field:
     return Field(name, lsb, width, doc, **kw)
 
@@ -150,56 +160,82 @@ REGISTERS: tuple[Register, ...] = (
               _f("height", 16, 16, "lines per frame", param="height"))),
     Register("CTRL", 0x008, "rw", "operating mode and the host's hold on the rectified and feature buffers",
              (_f("mode", 0, 1, "0 sequential (one stage after the other), 1 overlapped (double buffers)",
-                 values=((0, "sequential"), (1, "overlapped"))),
+                 values=((0, "sequential"), (1, "overlapped")), connect=_SEQ),
               _f("continuous", 1, 1, "0 single-shot (one stereo frame per start), 1 continuous (until stop)",
-                 values=((0, "single-shot"), (1, "continuous"))),
+                 values=((0, "single-shot"), (1, "continuous")), connect=_SEQ),
               _f("rect_want", 8, 1, "the host takes the newest rectified pair whenever it holds none "
-                 "(FrameControl.rect_want)"),
-              _f("feat_want", 9, 1, "the same for the feature lists (FrameControl.feat_want)"))),
+                 "(FrameControl.rect_want)", connect="sram_subsystem ctl_rect_want"),
+              _f("feat_want", 9, 1, "the same for the feature lists (FrameControl.feat_want)",
+                 connect="sram_subsystem ctl_feat_want"))),
     Register("CMD", 0x00C, "pulse", "commands (write 1 to act; reads 0)",
-             (_f("start", 0, 1, "start: one stereo frame (single-shot) or frames until stop (continuous)"),
-              _f("stop", 1, 1, "stop after the frame in progress"),
+             (_f("start", 0, 1, "start: one stereo frame (single-shot) or frames until stop (continuous)",
+                connect=_SEQ),
+              _f("stop", 1, 1, "stop after the frame in progress", connect=_SEQ),
               _f("rect_release", 8, 1, "the host has read the rectified pair it holds "
-                 "(FrameControl.rect_release)"),
-              _f("feat_release", 9, 1, "the host has read the feature lists it holds (FrameControl.feat_release)"))),
+                 "(FrameControl.rect_release)", connect="sram_subsystem ctl_rect_release"),
+              _f("feat_release", 9, 1, "the host has read the feature lists it holds (FrameControl.feat_release)",
+                 connect="sram_subsystem ctl_feat_release"))),
     Register("STATUS", 0x010, "status", "state of the system and of the frame buffers",
-             (_f("busy", 0, 1, "a start is being served (single-shot: until its frame's lists are written)"),
+             (_f("busy", 0, 1, "a start is being served (single-shot: until its frame's lists are written)",
+                connect=_SEQ),
               _f("avail", 4, 4, "a FULL frame waits in camera 0, camera 1, rectified, features (bits 4..7; "
-                 "FrameControl.avail)"),
-              _f("rect_held", 8, 1, "the host holds a rectified pair (FrameControl.rect_held)"),
-              _f("feat_held", 9, 1, "the host holds the feature lists (FrameControl.feat_held)"),
-              _f("rect_buf", 12, 1, "the rectified buffer held (0/1: its SRAM address, AddressMap.rectified)"),
-              _f("feat_buf", 13, 1, "the feature-list buffer held (AddressMap.features)"))),
+                 "FrameControl.avail)", connect="sram_subsystem ctl_avail"),
+              _f("rect_held", 8, 1, "the host holds a rectified pair (FrameControl.rect_held)",
+                 connect="sram_subsystem ctl_rect_held"),
+              _f("feat_held", 9, 1, "the host holds the feature lists (FrameControl.feat_held)",
+                 connect="sram_subsystem ctl_feat_held"),
+              _f("rect_buf", 12, 1, "the rectified buffer held (0/1: its SRAM address, AddressMap.rectified)",
+                 connect="sram_subsystem ctl_rect_buf"),
+              _f("feat_buf", 13, 1, "the feature-list buffer held (AddressMap.features)",
+                 connect="sram_subsystem ctl_feat_buf"))),
     Register("K_LEFT", 0x014, "rw", "Harris k of the left camera, ufix[8,8] (k = code / 256)",
-             (_f("k_left", 0, K_BITS, "k code (reset: 10, k = 0.039)", reset=K_RESET),)),
+             (_f("k_left", 0, K_BITS, "k code (reset: 10, k = 0.039)", reset=K_RESET,
+                 connect="the left Harris k port (Harris clock: change it between frames, or send it across "
+                         "with the thresholds)"),)),
     Register("K_RIGHT", 0x018, "rw", "Harris k of the right camera",
-             (_f("k_right", 0, K_BITS, "k code (reset: 10)", reset=K_RESET),)),
+             (_f("k_right", 0, K_BITS, "k code (reset: 10)", reset=K_RESET,
+                 connect="the right Harris k port (Harris clock)"),)),
     Register("FRAMES", 0x020, "status", "stereo frames completed since reset (both feature lists written)",
-             (_f("frames", 0, 32, "count, wraps"),)),
+             (_f("frames", 0, 32, "count, wraps", connect=_SEQ),)),
     Register("FEATURES", 0x024, "status", "features found in the last completed frame, per camera",
-             (_f("features_left", 0, 16, "left camera"), _f("features_right", 16, 16, "right camera"))),
+             (_f("features_left", 0, 16, "left camera",
+                 connect="feature_list (issue 14), left count (Harris clock: cross it, e.g. in Gray code or "
+                         "with the frame's end)"),
+              _f("features_right", 16, 16, "right camera", connect="feature_list (issue 14), right count "
+                                                                     "(Harris clock)"))),
     Register("DROPPED", 0x028, "status", "camera frames dropped (camera_interface's counters)",
-             (_f("dropped_left", 0, 16, "left camera"), _f("dropped_right", 16, 16, "right camera"))),
+             (_f("dropped_left", 0, 16, "left camera", connect="camera_pair dropped_l (already in the memory clock)"),
+              _f("dropped_right", 16, 16, "right camera", connect="camera_pair dropped_r"))),
     Register("OVERFLOWS", 0x02C, "status", "frames lost to overflows after the cameras",
-             (_f("harris_overflows", 0, 16, "stereo frames cut crossing into the Harris clock"),
-              _f("list_overflows", 16, 16, "feature lists that did not fit their SRAM buffer"))),
+             (_f("harris_overflows", 0, 16, "stereo frames cut crossing into the Harris clock",
+                 connect="stream_cdc dropped (its read clock, the Harris clock: cross it back in Gray code)"),
+              _f("list_overflows", 16, 16, "feature lists that did not fit their SRAM buffer",
+                 connect=_SEQ + " (counts the lists flagged overflowed in ARB words 20, 21)"))),
     Register("FRAME_CLOCKS", 0x030, "status", "memory clocks the last completed frame took from its start "
-             "(frames/s = 100e6 / value)", (_f("frame_clocks", 0, 32, "clocks"),)),
+             "(frames/s = 100e6 / value)", (_f("frame_clocks", 0, 32, "clocks", connect=_SEQ),)),
     Register("THR_LEFT", 0x100, "array", "pre-threshold of each 4x4 block of the left image, index by*4 + bx "
-             "(20-bit cornerness code; 0 after reset)", (_f("thr_left", 0, THRESHOLD_BITS, "threshold code"),),
+             "(20-bit cornerness code; 0 after reset)",
+             (_f("thr_left", 0, THRESHOLD_BITS, "threshold code",
+                 connect="the left pre-threshold's thr_we/thr_addr/thr_data, through a stream_cdc (24-bit "
+                         "one-beat frames) into the Harris clock"),),
              count=16, port="thr_left"),
     Register("THR_RIGHT", 0x140, "array", "the same for the right image",
-             (_f("thr_right", 0, THRESHOLD_BITS, "threshold code"),), count=16, port="thr_right"),
+             (_f("thr_right", 0, THRESHOLD_BITS, "threshold code",
+                 connect="the right pre-threshold's write port, the same way"),),
+             count=16, port="thr_right"),
     Register("FCOUNT", 0x180, "window", "features per block in the last completed frame: left blocks 0..15, "
              "right blocks 16..31 (read port addr = camera << 4 | block)",
-             (_f("fcount", 0, 16, "features in the block"),), count=32, port="fcount", latency=2,
-             words=tuple(f"{c}{b}" for c in ("left", "right") for b in range(16))),
+             (_f("fcount", 0, 16, "features in the block",
+                 connect="feature_list's per-block counters: a read port (address camera << 4 | block, data "
+                         "2 clocks later)"),),
+             count=32, port="fcount", latency=2, words=tuple(f"{c}{b}" for c in ("left", "right") for b in range(16))),
     Register("ARB", 0x200, "window", "the SRAM arbiter's status words (its status port, STAT in "
              "eyestereo.tools.models.sram_arbiter): words moved and clocks waited per master, frames per buffer",
-             (_f("arb", 0, 32, "status word"),), count=len(ARB_WORDS), port="arb", latency=2, words=ARB_WORDS),
+             (_f("arb", 0, 32, "status word", connect="sram_subsystem stat (StatPort)"),),
+             count=len(ARB_WORDS), port="arb", latency=2, words=ARB_WORDS),
     Register("SRAM", 0x400000, "memory", "the SRAM, one 16-bit word per bus word (bits 15..0; 31..16 read 0); "
              "frame buffers at eyestereo.tools.models.sram_arbiter.AddressMap",
-             (_f("data", 0, 16, "SRAM word"),), count=1 << 20, port="host"),
+             (_f("data", 0, 16, "SRAM word", connect="sram_subsystem host (HostPort)"),), count=1 << 20, port="host"),
 )
 
 
@@ -296,7 +332,8 @@ class RegisterMap:
         """The register table (one line per register) in Markdown."""
         out = ["| offset | name | kind | reset | fields | what |", "|---|---|---|---|---|---|"]
         for r in self.registers:
-            where = f"`{r.offset:#05x}`" if r.count == 1 else f"`{r.offset:#05x}`..`{r.offset + 4 * (r.count - 1):#05x}`"
+            last = r.offset + 4 * (r.count - 1)
+            where = f"`{r.offset:#05x}`" if r.count == 1 else f"`{r.offset:#05x}`..`{last:#05x}`"
             if r.kind == "const" and any(f.param for f in r.fields):
                 reset = "parameters"
             elif r.kind in ("const", "rw", "array"):
@@ -305,7 +342,7 @@ class RegisterMap:
                 reset = "-"
             flds = ", ".join(f"{f.name}[{f.bits}]" for f in r.fields)
             out.append(f"| {where} | {r.name} | {r.kind}{'' if r.count == 1 else f' x {r.count}'} | {reset} | "
-                       f"{flds} | {r.doc} |")
+                       f"{flds} | {_cell(r.doc)} |")
         return "\n".join(out)
 
     def document(self) -> str:
@@ -332,7 +369,24 @@ class RegisterMap:
                 "byte enables `wstrb[1:0]` and the response comes when the arbiter has taken the write "
                 "(posted: a later read of the same word returns it). A read waits for the arbiter.",
                 "* One access at a time: reads and writes alternate when both wait.", ""]
-        out += ["## Fields", ""]
+        out += ["## Connections in the system top", "",
+                "The bank runs in one clock (the memory clock, 100 MHz, like the arbiter's status and host "
+                "ports); ports that belong to another clock domain say how to cross.", "",
+                "| bank port | direction | connects to |", "|---|---|---|"]
+        for r in self.registers:
+            for f in r.fields:
+                if r.kind == "const":
+                    continue
+                if r.kind in ("rw", "pulse", "status"):
+                    port, d = f"regs_{f.name}", "in" if r.kind == "status" else "out"
+                elif r.kind == "array":
+                    port, d = f"regs_{r.port}_we/_addr/_data", "out"
+                elif r.kind == "window":
+                    port, d = f"{r.port}_addr / {r.port}_data", "out / in"
+                else:
+                    port, d = f"{r.port}_req_* / {r.port}_rsp_*", "out / in"
+                out.append(f"| `{port}` | {d} | {_cell(f.connect)} |")
+        out += ["", "## Fields", ""]
         for r in self.registers:
             out += [f"### {r.name} (`{r.offset:#05x}`, {r.kind})", "", r.doc, "",
                     "| bits | field | reset | what |", "|---|---|---|---|"]
@@ -340,7 +394,8 @@ class RegisterMap:
                 reset = f"parameter {f.param}" if f.param else (f"{f.reset:#x}" if r.kind in ("rw", "const",
                                                                                         "array") else "-")
                 vals = "; ".join(f"{v}: {t}" for v, t in f.values)
-                out.append(f"| {f.bits} | {f.name} | {reset} | {f.doc}{' (' + vals + ')' if vals else ''} |")
+                what = _cell(f.doc) + (f" ({vals})" if vals else "")
+                out.append(f"| {f.bits} | {f.name} | {reset} | {what} |")
             if r.words and r.kind == "window":
                 out += ["", "Words: " + ", ".join(f"{i} `{w}`" for i, w in enumerate(r.words)) + "."]
             out.append("")

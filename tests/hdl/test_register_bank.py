@@ -57,7 +57,8 @@ def test_a_wrong_field_port_is_refused():
         register_bank(*_ports(regs=regs).values())
 
 
-@pytest.mark.parametrize("kw,match", [(dict(width=1), "width=1 is too small"), (dict(height=4097), "height=4097 is too large"),
+@pytest.mark.parametrize("kw,match", [(dict(width=1), "width=1 is too small"),
+                                      (dict(height=4097), "height=4097 is too large"),
                                       (dict(width=8.0), "width must be an integer")])
 def test_bad_parameters_are_refused(kw, match):
     with pytest.raises(ValueError, match=rf"^register_bank: parameter {match}"):
