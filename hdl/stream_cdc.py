@@ -25,12 +25,17 @@ def stream_cdc(wclk, wrst, sink, rclk, rrst, source, dropped, *, depth: int = 16
     * the read side has no back-pressure (``ready`` is tied high inside): every word is presented as
       soon as it is in the output register, as a beat of the image stream in the read clock.
 
-    Rate: the crossing needs the read side to take beats at least as fast as they come on average. From
-    the rectifier (coordinate pairs every 4 memory clocks, each giving a left and a right pixel: at most
-    2 beats per 4 clocks at 100 MHz = 50 M beats/s; 25 M beats/s or less sustained, as each pixel takes 2
-    to 4 SRAM reads) into the Harris clock at 50 MHz (50 M beats/s) the FIFO stays within a few entries;
-    ``depth=16`` (LUT-RAM) leaves room for the synchronisers' latency and phase. A source faster than the
-    reader overflows it: the frame is then cut with a reset token and counted in ``dropped``.
+    Rate: the crossing needs the read side to take beats at least as fast as they come on average. The
+    rectifier's coordinate warper makes a coordinate pair every 4 memory clocks at best, each giving a left
+    and a right pixel: at most 2 beats per 4 clocks at 100 MHz, 50 M beats/s, exactly what the Harris
+    clock takes at 50 MHz (one beat per clock). Sustained, the SRAM holds the rectifier below that: its
+    pixels take 4 SRAM reads each (2 with the 2-read fetch), 8 (4) words per pair at one word per clock,
+    while the cameras' writes take 18 % of the SRAM's clocks: at most 20 M (41 M) beats/s. So the
+    read side is faster on average and the FIFO holds only the bursts and the synchronisers' delay:
+    ``depth=16`` (LUT-RAM) is plenty; the benches measure at most 8 entries in use. A source faster
+    than the reader overflows it: the frame is then cut with a reset token and counted in ``dropped``.
+    Reset tokens of the sink pass only when they cut a frame of which words are in the FIFO (the queue's
+    rule, :mod:`eyestereo.hdl.queue`); the read side's chain starts from ``rrst``.
 
     Ports:
         wclk, wrst: write clock and its synchronous active-high reset (the sink's producer shares it).
@@ -45,7 +50,7 @@ def stream_cdc(wclk, wrst, sink, rclk, rrst, source, dropped, *, depth: int = 16
     Latency: a beat written at a write edge comes out from the third read edge after it (two
     synchroniser flops and the FIFO's registered read), when the FIFO was empty.
 
-    Resources: the FIFO (depth x (data + 3 (mono) or data + 6 (stereo)) bits, LUT-RAM at depth 16) and
+    Resources: the FIFO (depth x (data + 2 (mono) or data + 5 (stereo)) bits, LUT-RAM at depth 16) and
     its pointers; see the README's block table.
     """
     check_clock(wclk, "wclk")
