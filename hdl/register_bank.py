@@ -66,7 +66,7 @@ def read_wait(regmap: RegisterMap = REGMAP) -> int:
 
 # ---- small blocks the bank is built of (each of fixed shape, so that the whole converts) -----------------
 @block
-def rb_hit(clk, rst, waddr, local, hit, *, base: int, lo: int, hi: int, count: int):
+def rb_hit(clk, rst, waddr, in_local, hit, *, base: int, lo: int, hi: int, count: int):
     """hit (registered): the word address lies in a register's region ``waddr[hi:lo] == base`` (and its
     index ``waddr[lo:0] < count`` where the region is larger than the register)."""
     full = count == 1 << lo
@@ -74,11 +74,11 @@ def rb_hit(clk, rst, waddr, local, hit, *, base: int, lo: int, hi: int, count: i
     if full:
         @always_seq(clk.posedge, reset=rst)
         def match():
-            hit.next = local and waddr[hi:lo] == base
+            hit.next = in_local and waddr[hi:lo] == base
     else:
         @always_seq(clk.posedge, reset=rst)
         def match():
-            hit.next = local and waddr[hi:lo] == base and waddr[lo:0] < count
+            hit.next = in_local and waddr[hi:lo] == base and waddr[lo:0] < count
 
     return match
 
@@ -329,7 +329,7 @@ def register_bank(clk, rst, bus, regs, arb, fcount, host, *, width: int = 352, h
     wstrb = Signal(intbv(0)[4:])
     cnt = Signal(intbv(0, min=0, max=RD_WAIT + 1))
     last_wr = Signal(bool(0))
-    local = Signal(bool(0))
+    in_local = Signal(bool(0))
     mem_sel = Signal(bool(0))
     wr_now = Signal(bool(0))
     awready, wready, arready = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
@@ -345,7 +345,7 @@ def register_bank(clk, rst, bus, regs, arb, fcount, host, *, width: int = 352, h
             continue
         hit = Signal(bool(0))
         lo = (r.span // 4 - 1).bit_length()
-        insts.append(rb_hit(clk, rst, waddr, local, hit, base=(r.offset // 4) >> lo, lo=lo, hi=LB, count=r.count))
+        insts.append(rb_hit(clk, rst, waddr, in_local, hit, base=(r.offset // 4) >> lo, lo=lo, hi=LB, count=r.count))
         hits.append(hit)
         we = Signal(bool(0))
         if r.kind in WRITABLE:
@@ -394,7 +394,7 @@ def register_bank(clk, rst, bus, regs, arb, fcount, host, *, width: int = 352, h
 
     @always_comb
     def decode():
-        local.next = waddr[WB:LB] == 0
+        in_local.next = waddr[WB:LB] == 0
         mem_sel.next = waddr[WB - 1]
         wr_now.next = state == t_state.WR and cnt == 1 and not mem_sel
 

@@ -211,7 +211,7 @@ async def register_bank_against_table(dut):
             await tb.expect_read(r.offset, r.name)
 
     # 5. windows (every word, in random order, twice with different contents)
-    for salt in (1, 2):
+    for salt in range(1, 1 + cfg.get("salts", 2)):
         tb.salt = salt
         for r in REGMAP.of_kind("window"):
             words = list(range(r.span // 4))
@@ -241,7 +241,13 @@ async def register_bank_against_table(dut):
     await tb.check_events("bad writes")
     assert len(tb.events) == n_events
     tb.check_outputs("after the bad writes")
-    await tb.dump("after the bad writes")
+    if cfg.get("full", True):
+        await tb.dump("after the bad writes")
+    else:  # every register's first and last word
+        for r in REGMAP:
+            if r.kind != "memory":
+                for i in sorted({0, r.count - 1}):
+                    await tb.expect_read(r.address(i), f"{r.name}[{i}] after the bad writes")
     report["gaps"] = len(gaps)
 
     # 8. the host driver on top
@@ -297,7 +303,7 @@ async def register_bank_against_table(dut):
     tb.bus.checker.check()
     c = tb.bus.checker
     assert c.counts["aw"] == c.counts["w"] == c.counts["b"] > 100, c.counts
-    assert c.counts["ar"] == c.counts["r"] > 300, c.counts
+    assert c.counts["ar"] == c.counts["r"] > (300 if cfg.get("full", True) else 150), c.counts
     report.update(counts=c.counts, write_latency=sorted(set(c.write_latency)),
                   read_latency=sorted(set(c.read_latency)), host_requests=tb.host_reqs)
     write_report(cfg, report)

@@ -84,3 +84,27 @@ def test_vhdl_ports_follow_the_table(tmp_path):
     assert ports["arb_addr"]["dir"] == "out" and ports["arb_data"]["dir"] == "in"
     assert ports["host_req_valid"]["dir"] == "out" and ports["host_rsp_data"]["dir"] == "in"
     # (tests/hdl/test_vhdl.py analyses it under both standards with every catalogue block)
+
+
+@pytest.mark.sim
+@pytest.mark.skipif(shutil.which("iverilog") is None, reason="Icarus Verilog not installed")
+def test_register_bank_verilog_on_icarus(request):
+    """MyHDL's Verilog back end can differ from its VHDL one: the same bench on the Verilog, in Icarus."""
+    from eyestereo.sim.sram_runner import run_sram_bench
+
+    rep = run_sram_bench("register_bank", "tb_register_bank", dict(seed=5, pause=0.2, salts=1, full=False, rw_writes=15),
+                         name=request.node.name,
+                         params=dict(width=64, height=48), sim="icarus")
+    assert rep["counts"]["ar"] > 150
+
+
+@needs_ghdl
+@pytest.mark.sim
+@pytest.mark.skipif(shutil.which("iverilog") is None, reason="Icarus Verilog not installed")
+def test_register_bank_netlist(request):
+    """The netlist make synth measures (GHDL's synthesis of the VHDL) passes the same bench, in Icarus."""
+    from eyestereo.sim.netlist import run_netlist_bench
+
+    rep = run_netlist_bench("register_bank", "tb_register_bank", dict(seed=6, pause=0.2, salts=1, full=False,
+                                                                         rw_writes=15), name=request.node.name)
+    assert rep["counts"]["ar"] > 150
