@@ -108,3 +108,15 @@ def test_register_bank_netlist(request):
     rep = run_netlist_bench("register_bank", "tb_register_bank", dict(seed=6, pause=0.2, salts=1, full=False,
                                                                          rw_writes=15), name=request.node.name)
     assert rep["counts"]["ar"] > 150
+
+
+@needs_ghdl
+@pytest.mark.sim
+def test_host_driver_on_the_sram_subsystem(request):
+    """The bank wired to the real arbiter and controller (sim/host_harness.py): the host reads a camera
+    frame and the arbiter's counters through the bus."""
+    import eyestereo.sim.host_harness  # noqa: F401  (registers the bench top)
+
+    rep = run_bench("host_system_tb", "tb_host_system", dict(seed=2, pause=0.2), name=request.node.name,
+                    params=dict(width=16, height=4, feature_words=64))
+    assert rep["arb"]["moved_cam0"] == 64 and rep["host_moves"] == 24 + 64
