@@ -41,6 +41,7 @@ from eyestereo.hdl.sram_controller import sram_controller
 from eyestereo.hdl.sram_subsystem import sram_subsystem
 from eyestereo.hdl.stream import ImageStream
 from eyestereo.hdl.stream_cdc import stream_cdc
+from eyestereo.hdl.word_cdc import word_cdc
 from eyestereo.tools.camera import WORD as CAMERA_WORD
 from eyestereo.hdl.stream_to_axis import stream_to_axis
 from eyestereo.tools.models import cornerness as corner_model
@@ -353,6 +354,12 @@ BLOCKS["stream_cdc"] = BlockSpec(
     dict(data_width=8, stereo=True, depth=16), sink_width=lambda p: p["data_width"],
     source_width=lambda p: p["data_width"], hw_params=("depth",), build=_build_stream_cdc,
     clocks=(("wclk", 100.0), ("rclk", 50.0)))
+BLOCKS["word_cdc"] = BlockSpec(
+    "word_cdc", "a multi-bit value into another clock by a toggle handshake, never torn (k codes, counts)",
+    word_cdc, dict(width=16), sink_width=lambda p: p["width"], source_width=lambda p: p["width"],
+    build=lambda p: dict(sclk=Signal(bool(0)), d=Signal(intbv(0)[p["width"]:]), dclk=Signal(bool(0)),
+                         q=Signal(intbv(0)[p["width"]:])),
+    clocks=(("sclk", 100.0), ("dclk", 50.0)))
 
 #: Simulation-only top levels (a bench harness around a block, registered by its module in
 #: ``eyestereo.sim``): :func:`get` finds them, ``make vhdl`` / ``make synth`` do not build them.
