@@ -39,7 +39,8 @@ def word_cdc(sclk, d, dclk, q):
     acknowledge takes three more source edges, so a change during a transfer waits up to 3 destination
     + 4 source clocks before its own capture.
 
-    Resources: 2 x width + 6 flip-flops, a width-bit comparator.
+    Resources: 2 x width + 7 flip-flops and a width-bit comparator; 16 bits (make synth, Yosys xc3se):
+    72 LUT, 39 FF; nextpnr-ecp5 234 MHz (sclk), 419 MHz (dclk).
     """
     check_clock(sclk, "sclk")
     check_signal("d", d)

@@ -30,8 +30,8 @@ def test_ports_are_checked(q, match):
 
 @pytest.mark.sim
 @pytest.mark.skipif(shutil.which("ghdl") is None, reason="GHDL not installed")
-@pytest.mark.parametrize("sclk,dclk", [((10000, 0), (20000, 3300)), ((20000, 0), (10000, 7100)),
-                                       ((10000, 0), (10000, 4900))], ids=["100to50", "50to100", "100to100"])
+@pytest.mark.parametrize("sclk,dclk", [((10000, 0), (20000, 3300)), ((20000, 0), (10000, 7100))],
+                         ids=["100to50", "50to100"])
 def test_words_cross(request, sclk, dclk):
     cfg = dict(sclk=list(sclk), dclk=list(dclk), changes=300, seed=len(request.node.name))
     rep = run_bench("word_cdc", "tb_word_cdc", cfg, name=request.node.name, params=dict(width=16))
