@@ -9,6 +9,7 @@ with cocotbext-axi's AxiLiteMaster and the bus checker, the SRAM model checking 
    the arbiter's published-frame count (``ARB``), finds the FULL buffer in the buffer-state word, and
    reads the frame back through the SRAM window: every word as sent (the address map of
    :class:`~eyestereo.tools.models.sram_arbiter.AddressMap`);
+   (the report gives the clocks per word of that read-out, on a quiet bus);
 3. the arbiter's counters seen through the bank: words moved by camera 0 and by the host equal what the
    bench counted; clocks since reset grow; STATUS.avail shows camera 0's FULL frame (the wiring).
 """
@@ -19,6 +20,7 @@ import random
 
 import cocotb
 from cocotb.clock import Clock
+from cocotb.simtime import get_sim_time
 from cocotb.triggers import ClockCycles, RisingEdge
 
 from eyestereo.sim.axil import AxiLiteHost
@@ -89,7 +91,10 @@ async def host_reads_a_camera_frame(dut):
     cam0 = states & 0xF
     full = [b for b in (0, 1) if (cam0 >> (2 * b)) & 3 == FULL]
     assert len(full) == 1, f"camera 0 buffer states {cam0:#x}: one FULL buffer expected"
+    bus.pauses(0)  # the read-out rate of a frame through the bus, master without pauses
+    t0 = get_sim_time(unit="ns")
     got = await drv.read_sram_words(amap.camera(0, full[0]), w * h)
+    clocks_per_word = (get_sim_time(unit="ns") - t0) / 10 / (w * h)
     host_moves += w * h
     assert got == cam.frames[0], "the frame read through the bus differs from the one camera 0 sent"
     st = await drv.status()
@@ -105,4 +110,5 @@ async def host_reads_a_camera_frame(dut):
     assert (await drv.read("ARB", 12)) - c1 >= 100
     bus.checker.check()
     assert sram.error is None
-    write_report(cfg, dict(host_moves=host_moves, arb=arb, axi=bus.checker.counts))
+    write_report(cfg, dict(host_moves=host_moves, arb=arb, axi=bus.checker.counts,
+                           sram_read_clocks_per_word=round(clocks_per_word, 2)))
