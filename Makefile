@@ -9,7 +9,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-$(shell (cat pyproject.toml 2>/dev/null || echo none) | cksum | cut -d' ' -f1)
 JOBS   ?= 2
 
-.PHONY: all setup ghdl vhdl sim test demo synth timing report bench clean distclean help
+.PHONY: all setup ghdl vhdl sim test demo synth timing regs report bench clean distclean help
 
 all: test
 
@@ -62,6 +62,10 @@ synth: setup
 # WaveDrom diagrams (docs/wavedrom/*.json) -> docs/img/timing/*.svg and docs/timing.md, offline.
 timing: setup
 	$(PY) -m eyestereo.hdl.timing
+
+# The register map (tools/regmap.py) -> docs/registers.md and README's register table.
+regs: setup
+	$(PY) -m eyestereo.tools.regmap
 
 # Every reproducible table and figure of the thesis -> docs/thesis.md (+ docs/img/thesis/); runs make synth first.
 report: synth

@@ -13,6 +13,7 @@ import numpy as np
 from myhdl import ResetSignal, Signal, intbv
 
 from eyestereo.hdl.async_fifo import async_fifo
+from eyestereo.hdl.axil import AxiLite
 from eyestereo.hdl.camera_bus import CameraBus
 from eyestereo.hdl.camera_interface import camera_interface, camera_pair
 from eyestereo.hdl.camera_stream import camera_stream
@@ -24,6 +25,7 @@ from eyestereo.hdl.harris_mono import harris_mono
 from eyestereo.hdl.harris_window import harris_window
 from eyestereo.hdl.nms import nms
 from eyestereo.hdl.prethreshold import prethreshold
+from eyestereo.hdl.register_bank import RegisterPorts, register_bank
 from eyestereo.hdl.coord_pair import CoordPair
 from eyestereo.hdl.coordinate_warper import coordinate_warper
 from eyestereo.hdl.line_delay import line_delay
@@ -38,6 +40,8 @@ from eyestereo.hdl.sram_bus import HostPort, SramCmd, SramPins, SramRsp, StatPor
 from eyestereo.hdl.sram_controller import sram_controller
 from eyestereo.hdl.sram_subsystem import sram_subsystem
 from eyestereo.hdl.stream import ImageStream
+from eyestereo.hdl.stream_cdc import stream_cdc
+from eyestereo.hdl.word_cdc import word_cdc
 from eyestereo.tools.camera import WORD as CAMERA_WORD
 from eyestereo.hdl.stream_to_axis import stream_to_axis
 from eyestereo.tools.models import cornerness as corner_model
@@ -323,6 +327,39 @@ BLOCKS["sram_subsystem"] = BlockSpec(
     hw_params=tuple(_ARB) + ("kind", "read_latency"), build=lambda p: dict(_clk_rst(), **_masters(p), sram=SramPins()),
     clocks=(("clk", 100.0),))
 
+
+# --- the complete system (issue 15): the register bank on the AXI4-Lite register bus ---------------------
+def _build_register_bank(p):
+    from eyestereo.tools.regmap import REGMAP
+
+    return dict(_clk_rst(), bus=AxiLite(REGMAP.addr_bits), regs=RegisterPorts(REGMAP), arb=StatPort(),
+                fcount=StatPort(5, 16), host=HostPort())
+
+
+BLOCKS["register_bank"] = BlockSpec(
+    "register_bank", "the register map (tools/regmap.py) on an AXI4-Lite slave: control, k, thresholds, status, "
+    "arbiter counters, SRAM window", register_bank, dict(width=352, height=288), sink_width=lambda p: 32,
+    source_width=lambda p: 32, hw_params=("width", "height"), build=_build_register_bank, clocks=(("clk", 100.0),))
+
+
+def _build_stream_cdc(p):
+    return dict(wclk=Signal(bool(0)), wrst=_rst(), sink=ImageStream(p["data_width"], stereo=p["stereo"]),
+                rclk=Signal(bool(0)), rrst=_rst(), source=ImageStream(p["data_width"], stereo=p["stereo"]),
+                dropped=Signal(intbv(0)[16:]))
+
+
+BLOCKS["stream_cdc"] = BlockSpec(
+    "stream_cdc", "an image stream, mono or stereo, into another clock (async_fifo inside; whole stereo frames "
+    "or a reset token): the rectifier's stream into the Harris clock", stream_cdc,
+    dict(data_width=8, stereo=True, depth=16), sink_width=lambda p: p["data_width"],
+    source_width=lambda p: p["data_width"], hw_params=("depth",), build=_build_stream_cdc,
+    clocks=(("wclk", 100.0), ("rclk", 50.0)))
+BLOCKS["word_cdc"] = BlockSpec(
+    "word_cdc", "a multi-bit value into another clock by a toggle handshake, never torn (k codes, counts)",
+    word_cdc, dict(width=16), sink_width=lambda p: p["width"], source_width=lambda p: p["width"],
+    build=lambda p: dict(sclk=Signal(bool(0)), d=Signal(intbv(0)[p["width"]:]), dclk=Signal(bool(0)),
+                         q=Signal(intbv(0)[p["width"]:])),
+    clocks=(("sclk", 100.0), ("dclk", 50.0)))
 
 #: Simulation-only top levels (a bench harness around a block, registered by its module in
 #: ``eyestereo.sim``): :func:`get` finds them, ``make vhdl`` / ``make synth`` do not build them.

@@ -73,8 +73,9 @@ def analyse(netlist: dict, top: str) -> dict:
         k = _kind(t)
         if t in SEQ or t == "BUFG":
             return DELAY["CKO"], (cn,)
-        if k == "RAM" and port in ("SPO", "DPO"):
-            # asynchronous read: SPO from the write address A*, DPO from the read address DPRA*
+        if k == "RAM" and port in ("SPO", "DPO", "O"):
+            # asynchronous read: SPO (RAM16X1D) and O (RAM16X1S) from the address A*, DPO from the read
+            # address DPRA*; never from D or WE (a read-modify-write through the RAM is no loop)
             pre = "DPRA" if port == "DPO" else "A"
             ins = [b for p, b in sinks[cn] if p.startswith(pre) and not (pre == "A" and p.startswith("ADDR"))]
             best = max((arrival(b) for b in ins), default=(0.0, ()))

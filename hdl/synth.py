@@ -86,6 +86,10 @@ ECP5 = ("--25k", "--package", "CABGA381", "--speed", "6")
 #: ports) are placed on the largest package instead, same speed grade: the figure is then for that device.
 ECP5_WIDE = ("--85k", "--package", "CABGA756", "--speed", "6")
 ECP5_IOS = 197
+#: User I/O of ECP5_WIDE's package (LFE5U-85F, CABGA756). A block with more port bits (the register bank:
+#: the AXI4-Lite port and one port per register field) is not placed; its fmax cell says so, and its
+#: Spartan-3E estimate (eyestereo.hdl.sta) stands for its logic depth.
+ECP5_WIDE_IOS = 365
 
 
 def _port_bits(netlist_json: Path, top: str) -> int:
@@ -230,7 +234,11 @@ def ecp5(job: dict, *, freq: float = 100.0, seed: int = 1) -> dict:
     clocks = list(job["clocks"])
     (d / "ecp5.lpf").write_text("".join(f'FREQUENCY PORT "{c}" {freq:.1f} MHz;\n' for c in clocks))
     t0 = time.perf_counter()
-    device = ECP5 if _port_bits(d / "ecp5.json", job["block"]) <= ECP5_IOS else ECP5_WIDE
+    bits = _port_bits(d / "ecp5.json", job["block"])
+    if bits > ECP5_WIDE_IOS:
+        return dict(fmax={}, ecp5={}, ecp5_device=f"not placed: {bits} port bits, more than the {ECP5_WIDE_IOS} I/O "
+                    "of the largest package")
+    device = ECP5 if bits <= ECP5_IOS else ECP5_WIDE
     cmd = nextpnr_command() + list(device) + [
         "--json", "ecp5.json", "--lpf", "ecp5.lpf", "--lpf-allow-unconstrained", "--timing-allow-fail",
         "--seed", str(seed), "--report", "pnr_report.json", "--log", "nextpnr.log", "-q"]
@@ -262,7 +270,7 @@ def synth_block(name: str, out: Path, *, label: str | None = None, pnr: bool = F
 def _fmax_cell(r: dict) -> str:
     fm = r.get("fmax")
     if not fm:
-        return "-"
+        return "not placed: more port bits than I/O" if str(r.get("ecp5_device", "")).startswith("not placed") else "-"
     parts = []
     for clk, v in fm.items():
         a = v.get("achieved")
