@@ -257,7 +257,7 @@ BLOCKS: dict[str, BlockSpec] = {
         hw_params=("quantizers", "frac", "source_width", "source_height"), build=_build_coordinate_warper),
     "fetch_interpolate": BlockSpec(
         "fetch_interpolate", "coordinate pairs -> fetch port (previous 2x2 reused) -> bilinear MAC -> 8-bit stereo stream",
-        fetch_interpolate, dict(_POLY_DEFAULTS, depth=DEFAULT_DEPTH, coefficients="constant"),
+        fetch_interpolate, {k: v for k, v in _RECT_DEFAULTS.items() if k != "coefficients"},
         source_width=lambda p: 8, hw_params=("depth",), build=_build_fetch_interpolate),
     "rectifier": BlockSpec(
         "rectifier", "coordinate_warper + fetch_interpolate: calibration in, rectified 8-bit stereo stream out",
