@@ -280,17 +280,26 @@ def figure(path: Path = FIG) -> Path | None:
     return path
 
 
-def resources() -> list[dict]:
+def resources(reuse: bool = False) -> list[dict]:
+    """Yosys xc3se cell counts of GHDL's netlist (make synth's flow); ``reuse``: from an earlier run's
+    ``stat.txt`` where there is one."""
     from eyestereo.hdl import synth
 
+    folder = BUILD.parent / "synth_rectifier"
     out = []
     for label, block, params in (("fetch_interpolate", "fetch_interpolate", {}), ("rectifier", "rectifier", {}),
                                  ("rectifier, OpenCV 640x480", "rectifier", dict(quantizers="opencv"))):
+        stat = folder / slug(label) / "stat.txt"
+        if reuse and stat.exists():
+            out.append(dict(label=label, block=block, **synth.summarize(synth.parse_stat(stat.read_text()))))
+            continue
         print(f"bench_rectifier: synthesizing {label} ...", flush=True)
         try:
-            out.append(synth.synth_block(block, BUILD.parent / "synth_rectifier", label=label, pnr=False, **params))
-        except (FileNotFoundError, RuntimeError) as exc:
+            r = synth.synth_block(block, folder, label=label, pnr=False, **params)
+        except (FileNotFoundError, RuntimeError, ValueError) as exc:
             print(f"bench_rectifier: skipped {label}: {exc}", file=sys.stderr)
+            continue
+        out.append(dict(label=label, block=block, **r["summary"]))
     (OUT / "resources.json").write_text(json.dumps(out, indent=2, default=str) + "\n")
     return out
 
@@ -356,8 +365,8 @@ def report_text(res: dict, rs: list[dict]) -> str:
               "| block | LUT | LUT-RAM | FF | RAMB16 | MULT18X18 | thesis MULT18X18 | thesis LUT |", "|---|---:|---:|---:|---:|---:|---:|---:|"]
         for r in rs:
             th = THESIS.get(r.get("block", ""), ("-", "-"))
-            L.append(f"| {r.get('label')} | {r.get('lut', '?')} | {r.get('lutram', 0)} | {r.get('ff', '?')} | "
-                     f"{r.get('ramb16', 0)} | {r.get('mult', '?')} | {th[0]} | {th[1]} |")
+            L.append(f"| {r.get('label')} | {r.get('LUT', '?')} | {r.get('LUTRAM', 0)} | {r.get('FF', '?')} | "
+                     f"{r.get('RAMB16', 0)} | {r.get('MULT18X18', '?')} | {th[0]} | {th[1]} |")
         L.append("")
     if FIG.exists():
         L += ["![Fig. 4.12](img/rectifier_fig412.png)", "",
@@ -383,6 +392,7 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="the synthetic rig only")
     ap.add_argument("--only", help="run only the frames whose label contains this")
     ap.add_argument("--no-synth", action="store_true")
+    ap.add_argument("--reuse-synth", action="store_true", help="cell counts of an earlier synthesis where present")
     ap.add_argument("--no-write", action="store_true")
     a = ap.parse_args(argv)
     OUT.mkdir(parents=True, exist_ok=True)
@@ -391,7 +401,7 @@ def main(argv=None) -> int:
     if a.phase in ("report", "all"):
         res = analyse()
         (OUT / "analysis.json").write_text(json.dumps(res, indent=2, default=lambda o: None) + "\n")
-        rs = [] if a.no_synth else resources()
+        rs = [] if a.no_synth else resources(a.reuse_synth)
         if not rs and (OUT / "resources.json").exists():
             rs = json.loads((OUT / "resources.json").read_text())
         figure()
