@@ -126,6 +126,14 @@ class FetchMemory:
                 self.beats.append((first, i, int(img[y + oy, x + ox])))
                 self.reads += 1
 
+    def clear(self) -> None:
+        """Forget everything (the memory side reset together with the DUT)."""
+        self.requests.clear()
+        self.beats.clear()
+        self.offered = None
+        self.stall_left = 0
+        self.reads = 0
+
     @property
     def idle(self) -> bool:
         return not self.beats and self.offered is None

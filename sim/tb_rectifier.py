@@ -8,7 +8,8 @@ model's); ``busy`` low after the last frame, no beat, request or response left o
 
 Configuration: ``params`` (the rectifier's), ``images`` ("random:SEED" or ``{"left": PATH.npy, "right":
 PATH.npy}``), ``frames`` (back to back, same images), the memory's ``seed``, ``ready_p``, ``latency``,
-``wait_p``, ``stall_p``, ``stall``; ``lenient`` (record ``bit_exact`` instead of failing on a data
+``wait_p``, ``stall_p``, ``stall``; ``reset_after`` (abandon a first frame with ``rst`` after that many
+beats, the memory reset with it, then run the frames); ``lenient`` (record ``bit_exact`` instead of failing on a data
 difference: the ``eyestereo sim rectify`` command), ``dump`` (an .npz of the rectified images),
 ``progress`` (a file the bench updates with "beats total" now and then).
 """
@@ -113,6 +114,23 @@ async def rectifier_frames(dut):
     await reset(dut, clk)
     loop = Clocked(clk, [mem, mon], progress=cfg.get("progress"), total=2 * npx * frames, monitor=mon)
     cocotb.start_soon(loop.run())
+    if cfg.get("reset_after"):  # a frame abandoned with rst (the memory side reset with it)
+        await FallingEdge(clk)
+        dut.start.value = 1
+        await FallingEdge(clk)
+        dut.start.value = 0
+        await wait_beats(clk, mon, int(cfg["reset_after"]), 100 * npx + 5000, "frame before rst")
+        await FallingEdge(clk)
+        dut.rst.value = 1
+        mem.clear()
+        await ClockCycles(clk, 3)
+        await FallingEdge(clk)
+        dut.rst.value = 0
+        mem.clear()
+        mon.beats.clear()
+        mon.clocks.clear()
+        await ClockCycles(clk, 5)
+        assert not int(dut.busy.value) and not mon.beats, "rst must end the frame"
     starts = []
     per = 8 + 400 * float(cfg.get("stall_p", 0)) * 100 + 20 * float(cfg.get("wait_p", 0)) + 8 / float(cfg.get("ready_p", 1))
     for f in range(frames):

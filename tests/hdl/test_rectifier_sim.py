@@ -42,6 +42,7 @@ RECT_CASES = {  # calibration, memory, frames
     "rig_at_once": ("rig:32x20", AT_ONCE, 2),
     "rig_random": ("rig:32x20", RANDOM, 1),
     "seeded_stalls": ("seed:5:3@24x16", STALLS, 2),
+    "reset_mid_frame": ("rig:24x16", RANDOM, 1),
 }
 
 
@@ -49,7 +50,8 @@ RECT_CASES = {  # calibration, memory, frames
 def test_rectifier(request, case):
     spec, mem, frames = RECT_CASES[case]
     seed = sorted(RECT_CASES).index(case) + 31
-    rep = run_bench("rectifier", "tb_rectifier", dict(mem, seed=seed, frames=frames, images=f"random:{seed}"),
+    extra = dict(reset_after=301) if case == "reset_mid_frame" else {}
+    rep = run_bench("rectifier", "tb_rectifier", dict(mem, seed=seed, frames=frames, images=f"random:{seed}", **extra),
                     name=request.node.name, params=dict(quantizers=spec))
     assert rep["bit_exact"] and rep["beats"] == 2 * frames * rep["width"] * rep["height"]
     assert rep["reads"] == rep["reads_model"]
