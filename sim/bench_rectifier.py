@@ -290,8 +290,9 @@ def resources(reuse: bool = False) -> list[dict]:
     for label, block, params in (("fetch_interpolate", "fetch_interpolate", {}), ("rectifier", "rectifier", {}),
                                  ("rectifier, OpenCV 640x480", "rectifier", dict(quantizers="opencv"))):
         stat = folder / slug(label) / "stat.txt"
-        if reuse and stat.exists():
-            out.append(dict(label=label, block=block, **synth.summarize(synth.parse_stat(stat.read_text()))))
+        if reuse:
+            if stat.exists():
+                out.append(dict(label=label, block=block, **synth.summarize(synth.parse_stat(stat.read_text()))))
             continue
         print(f"bench_rectifier: synthesizing {label} ...", flush=True)
         try:
@@ -392,7 +393,7 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="the synthetic rig only")
     ap.add_argument("--only", help="run only the frames whose label contains this")
     ap.add_argument("--no-synth", action="store_true")
-    ap.add_argument("--reuse-synth", action="store_true", help="cell counts of an earlier synthesis where present")
+    ap.add_argument("--reuse-synth", action="store_true", help="cell counts of an earlier synthesis only (none where there is none)")
     ap.add_argument("--no-write", action="store_true")
     a = ap.parse_args(argv)
     OUT.mkdir(parents=True, exist_ok=True)
