@@ -41,6 +41,7 @@ from eyestereo.tools.io import atomic_write_text
 OUT = ROOT / "build" / "bench_rectifier"
 DOC = ROOT / "docs" / "rectifier.md"
 FIG = ROOT / "docs" / "img" / "rectifier_fig412.png"
+FIG_RIG = ROOT / "docs" / "img" / "rectifier_rig.png"
 BEGIN, END = "<!-- rectifier-bench:begin -->", "<!-- rectifier-bench:end -->"
 #: Thesis Table 4.4 (Xilinx ISE): MULT18X18, LUTs.
 THESIS = {"fetch_interpolate": (2, 23), "rectifier": (11, 384)}
@@ -254,9 +255,9 @@ def _stats(d: np.ndarray) -> dict:
     return dict(mean=float(a.mean()), max=float(a.max()), n=int(a.size))
 
 
-def figure(path: Path = FIG) -> Path | None:
-    """Fig. 4.12: the OpenCV pair before and after the hardware rectification, with horizontal lines."""
-    runs = [p for p in sorted(OUT.glob("*640x480*at_once*/out.npz"))] or [p for p in sorted(OUT.glob("*/out.npz"))]
+def figure(path: Path = FIG, pattern: str = "*640x480*at_once*") -> Path | None:
+    """Fig. 4.12: a pair before and after the hardware rectification, with horizontal lines."""
+    runs = sorted(OUT.glob(f"{pattern}/out.npz"))
     if not runs:
         return None
     folder = runs[0].parent
@@ -373,6 +374,9 @@ def report_text(res: dict, rs: list[dict]) -> str:
         L += ["![Fig. 4.12](img/rectifier_fig412.png)", "",
               "The OpenCV chessboard pair 01 before (top, camera images) and after (bottom) the rectification in GHDL "
               "(the rectifier's VHDL, memory model at once), lines every 32 rows.", ""]
+    if FIG_RIG.exists():
+        L += ["![synthetic rig](img/rectifier_rig.png)", "",
+              "The synthetic-rig scene (352x288) before and after the rectification in GHDL, lines every 32 rows.", ""]
     return "\n".join(L)
 
 
@@ -406,6 +410,7 @@ def main(argv=None) -> int:
         if not rs and (OUT / "resources.json").exists():
             rs = json.loads((OUT / "resources.json").read_text())
         figure()
+        figure(FIG_RIG, "*352x288*at_once*")
         text = report_text(res, rs)
         print(text)
         if not a.no_write:
