@@ -142,8 +142,8 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
     y0, ty = Signal(intbv(0)[iy:]), Signal(intbv(0)[iy:])
     tv = Signal(bool(0))
     dx, dy = Signal(intbv(0)[fw:]), Signal(intbv(0)[fw:])
-    ddx = Signal(intbv(0, min=-(1 << ix), max=1 << ix))
-    ddy = Signal(intbv(0, min=-(1 << iy), max=1 << iy))
+    tx1, x01 = Signal(intbv(0)[ix + 1:]), Signal(intbv(0)[ix + 1:])
+    ty1, y01 = Signal(intbv(0)[iy + 1:]), Signal(intbv(0)[iy + 1:])
     cx, cy = Signal(intbv(0)[2:]), Signal(intbv(0)[2:])
     code = Signal(intbv(0)[4:])
     rom_mask = Signal(intbv(0)[4:])
@@ -192,27 +192,30 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
             dy.next = yl[fw:0]
 
     @always_comb
-    def deltas():
-        ddx.next = x0 - tx
-        ddy.next = y0 - ty
+    def plus_one():
+        tx1.next = tx + 1
+        x01.next = x0 + 1
+        ty1.next = ty + 1
+        y01.next = y0 + 1
 
     @always_comb
     def reuse_code():
-        # 3 (never a valid code): no reuse
-        if ddx == -1:
-            cx.next = 0
-        elif ddx == 0:
+        # ddx = x0 - tx in -1..1 by unsigned comparisons only (no negative constants: MyHDL's Verilog
+        # compares a signed case expression with unsigned negative items); 3 = no reuse
+        if x0 == tx:
             cx.next = 1
-        elif ddx == 1:
+        elif x0 == tx1:
             cx.next = 2
+        elif x01 == tx:
+            cx.next = 0
         else:
             cx.next = 3
-        if ddy == -1:
-            cy.next = 0
-        elif ddy == 0:
+        if y0 == ty:
             cy.next = 1
-        elif ddy == 1:
+        elif y0 == ty1:
             cy.next = 2
+        elif y01 == ty:
+            cy.next = 0
         else:
             cy.next = 3
 
@@ -488,6 +491,6 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
     def busy_out():
         busy.next = state != IDLE or dcount != 0 or v1 or v2
 
-    return (side, fractions, deltas, reuse_code, reuse_code2, mask_rom, src_rom, request, request2, requester, queue_mem,
+    return (side, fractions, plus_one, reuse_code, reuse_code2, mask_rom, src_rom, request, request2, requester, queue_mem,
             rfifo_mem, rfifo, rfifo_head, unpack, unpack2, step_select, kept_index, kept_read, step_fire,
             weights, multiply_weight, interpolator, keep, rounding, busy_out)

@@ -148,11 +148,24 @@ def run_frame(label: str, spec: str, left: np.ndarray, right: np.ndarray, mem: d
     t0 = time.perf_counter()
     rep = run_bench("rectifier", "tb_rectifier", cfg, name=f"bench_{slug(label)}", params=dict(quantizers=spec))
     rep.update(label=label, spec=spec, memory=mem, seed=seed, wall=time.perf_counter() - t0,
-               backend=os.environ.get("GHDL_BACKEND", "mcode"))
+               backend=os.environ.get("GHDL_BACKEND", "mcode"), revision=_revision())
     (folder / "report.json").write_text(json.dumps(rep, indent=2) + "\n")
     print(f"bench_rectifier: {label}: {rep['clocks_per_pixel']:.3f} clocks/px, {rep['reads_per_output_pixel']:.3f} "
           f"reads/px, bit exact {rep['bit_exact']}, {rep['wall']:.0f} s", flush=True)
     return rep
+
+
+def _revision() -> str:
+    """The commit the HDL was converted from (``+`` when the HDL has uncommitted changes)."""
+    import subprocess
+
+    try:
+        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "hdl", "tools/models"], cwd=ROOT, capture_output=True,
+                               text=True).stdout.strip()
+    except OSError:
+        return "?"
+    return head + ("+" if dirty else "")
 
 
 def frames_to_run(quick: bool) -> list[tuple[str, str, str, dict, int]]:
@@ -318,7 +331,7 @@ def report_text(res: dict, rs: list[dict]) -> str:
               "camera (the thesis reads 4 per output pixel); per in-range output pixel: without the black ones, which "
               "need no read.", "",
               "| frame | memory | stereo pixels | bit-exact | clocks / stereo pixel | reads / output pixel | "
-              "reads / in-range pixel | thesis | black sides | sim wall |", "|---|---|---:|---|---:|---:|---:|---:|---:|---:|"]
+              "reads / in-range pixel | thesis | black sides | sim wall | HDL revision |", "|---|---|---:|---|---:|---:|---:|---:|---:|---:|---|"]
         for r in fr:
             m = r["memory"]
             mem = ("at once" if m.get("wait_p", 0) == 0 and m.get("ready_p", 1) >= 1 else
@@ -327,7 +340,7 @@ def report_text(res: dict, rs: list[dict]) -> str:
             L.append(f"| {r['label'].split(',')[0]} (`{r['spec']}`, seed {r['seed']}) | {mem} | {r['width'] * r['height']:,} | "
                      f"{'yes' if r['bit_exact'] else 'NO'} | {r['clocks_per_pixel']:.3f} | {r['reads_per_output_pixel']:.3f} | "
                      f"{r['reads_per_inrange_pixel']:.3f} | 4 | {100 * r['oor_sides'] / (2 * r['width'] * r['height']):.1f} % | "
-                     f"{r['wall']:.0f} s |")
+                     f"{r['wall']:.0f} s | {r.get('revision', '4d75c52')} |")
         L.append("")
     if res["remap"]:
         L += ["Hardware images against OpenCV's `remap` (float32 maps, `INTER_LINEAR`) of the same camera images, "
