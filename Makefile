@@ -87,6 +87,7 @@ bench: setup
 	$(PY) -m eyestereo.sim.bench_sram --out docs/sram.md
 	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.tools.reports.rectifier_precision
 	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.sim.bench_warper
+	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.sim.bench_rectifier
 
 clean:
 	rm -rf build .pytest_cache .hypothesis

@@ -28,8 +28,10 @@ from eyestereo.hdl.prethreshold import prethreshold
 from eyestereo.hdl.register_bank import RegisterPorts, register_bank
 from eyestereo.hdl.coord_pair import CoordPair
 from eyestereo.hdl.coordinate_warper import coordinate_warper
+from eyestereo.hdl.fetch_interpolate import DEFAULT_DEPTH, fetch_interpolate
 from eyestereo.hdl.line_delay import line_delay
 from eyestereo.hdl.poly_unit import CoefPort, poly_unit
+from eyestereo.hdl.rectifier import rectifier
 from eyestereo.hdl.sobel import sobel
 from eyestereo.hdl.stream_checker import stream_checker
 from eyestereo.hdl.queue import QueuePort
@@ -198,6 +200,23 @@ def _build_coordinate_warper(p):
                 **_coef_port(p, cal))
 
 
+def _build_fetch_interpolate(p):
+    cal = _calibration(p)
+    return dict(clk=Signal(bool(0)), rst=_rst(),
+                coord=CoordPair(cal.source_width, cal.source_height, poly_model.resolve_frac(cal, p["frac"])),
+                fetch=FetchPort(cal.source_width, cal.source_height), source=ImageStream(8, stereo=True),
+                busy=Signal(bool(0)))
+
+
+def _build_rectifier(p):
+    cal = _calibration(p)
+    return dict(clk=Signal(bool(0)), rst=_rst(), start=Signal(bool(0)),
+                fetch=FetchPort(cal.source_width, cal.source_height), source=ImageStream(8, stereo=True),
+                busy=Signal(bool(0)), **_coef_port(p, cal))
+
+
+_RECT_DEFAULTS = dict(_POLY_DEFAULTS, depth=DEFAULT_DEPTH)
+
 BLOCKS: dict[str, BlockSpec] = {
     "line_delay": BlockSpec(
         "line_delay", "one-line FIFO in block RAM: pixel (x, y-1) at (x, y)", line_delay,
@@ -240,6 +259,14 @@ BLOCKS: dict[str, BlockSpec] = {
         "coordinate_warper", "x/y counters, poly_unit and the double-buffered coordinate pair output (4 clocks/pair)",
         coordinate_warper, _POLY_DEFAULTS,
         hw_params=("quantizers", "frac", "source_width", "source_height"), build=_build_coordinate_warper),
+    "fetch_interpolate": BlockSpec(
+        "fetch_interpolate", "coordinate pairs -> fetch port (previous 2x2 reused) -> bilinear MAC -> 8-bit stereo stream",
+        fetch_interpolate, {k: v for k, v in _RECT_DEFAULTS.items() if k != "coefficients"},
+        source_width=lambda p: 8, hw_params=("depth",), build=_build_fetch_interpolate),
+    "rectifier": BlockSpec(
+        "rectifier", "coordinate_warper + fetch_interpolate: calibration in, rectified 8-bit stereo stream out",
+        rectifier, _RECT_DEFAULTS, source_width=lambda p: 8,
+        hw_params=("quantizers", "frac", "source_width", "source_height", "depth"), build=_build_rectifier),
     "harris_mono": BlockSpec(
         "harris_mono", "Harris corners: Sobel -> window -> cornerness -> pre-threshold -> NMS", harris_mono,
         dict(width=352, height=288, blocks=(4, 4), nms=3),

@@ -34,6 +34,19 @@ Timing of a 4x2 frame with idle cycles, then a reset token and the next frame (`
     eof     .    _    _    .    _    _    _    _    _    #    .    #    _
     data    .   0,0  1,0   .   2,0  3,0  0,1  1,1  2,1  3,1   .   tok  0,0
 
+Stereo streams (``ImageStream(n, stereo=True)``) carry two frames of one geometry interleaved pixel by
+pixel: left pixel (x, y) with ``cam`` 0, then right pixel (x, y) with ``cam`` 1, each a beat of its own
+(idle cycles allowed anywhere, also between the two beats of a pixel); ``eol`` on both beats of a line's
+last pixel, ``eof`` with ``eol`` on both beats of the frame's last pixel; a reset token with either
+``cam`` resets both sides. A 2x2 stereo frame (``L``/``R`` the camera)::
+
+    cycle   0     1     2     3     4     5     6     7     8     9
+    valid   #     #     _     #     #     #     #     _     #     #
+    cam     0     1     .     0     1     0     1     .     0     1
+    eol     _     _     .     #     #     _     _     .     #     #
+    eof     _     _     .     _     _     _     _     .     #     #
+    data   L0,0  R0,0   .    L1,0  R1,0  L0,1  R0,1   .    L1,1  R1,1
+
 Frame geometry is fixed at elaboration (``width`` x ``height`` parameters of each block). A block's source
 emits frames of the geometry its docstring states (the sink's, for all filters), with the same
 valid/eol/eof pattern per frame, after a latency given in the block's docstring.
