@@ -21,6 +21,7 @@ from eyestereo.hdl.axis_to_stream import axis_to_stream
 from eyestereo.hdl.convolve import convolve
 from eyestereo.hdl.cornerness import cornerness
 from eyestereo.hdl.harris_mono import harris_mono
+from eyestereo.hdl.harris_stereo import harris_stereo
 from eyestereo.hdl.harris_window import harris_window
 from eyestereo.hdl.nms import nms
 from eyestereo.hdl.prethreshold import prethreshold
@@ -242,6 +243,14 @@ BLOCKS: dict[str, BlockSpec] = {
         sink_width=lambda p: 8, source_width=lambda p: nms_model.WORD.width,
         hw_params=("width", "height", "blocks", "nms"),
         control=(("k", _k_port),) + _thr_ports()),
+    "harris_stereo": BlockSpec(
+        "harris_stereo", "stereo Harris corners: one datapath for both cameras, shared line delays and "
+        "multipliers (share 1/2/3), k and block thresholds per camera", harris_stereo,
+        dict(width=352, height=288, blocks=(4, 4), nms=3, share=3, stereo=True),
+        sink_width=lambda p: 8, source_width=lambda p: nms_model.WORD.width,
+        hw_params=("width", "height", "blocks", "nms", "share"),
+        control=(("k_left", _k_port), ("k_right", _k_port), _thr_ports()[0],
+                 ("thr_cam", lambda p: Signal(bool(0))), *_thr_ports()[1:])),
     "stream_checker": BlockSpec(
         "stream_checker", "protocol checker: lines/frames of the wrong size, stereo interleaving; sticky error "
         "and fault code; optional repair (broken frames become reset tokens)", stream_checker,
