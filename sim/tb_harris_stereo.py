@@ -134,9 +134,12 @@ async def harris_stereo_frames(dut):
     assert not monitor.undefined, f"undefined bits on valid beats: {monitor.undefined[:4]}"
     asm, order = split_cameras(got, w, h)
     assert order.count("token") == tokens, f"{order.count('token')} tokens out, {tokens} in"
+    start = 0
     if tokens:
-        assert got[0][3] and not got[0][2], "the reset token must come out first"
-    pix = [b for b in got if not (b[3] and not b[2])]
+        for a in asm:
+            assert a.events and a.events[0][0] == "token", "the reset token must come out before the first frame"
+        start = next(i for i, b in enumerate(got) if b[3] and not b[2]) + 1
+    pix = [b for b in got[start:] if not (b[3] and not b[2])]
     cams = [b[4] for b in pix]
     assert cams == [0, 1] * (len(pix) // 2) and len(pix) % 2 == 0, "left and right beats do not alternate"
     gaps = np.diff([b[0] for b in got])
@@ -172,7 +175,8 @@ async def harris_stereo_frames(dut):
     assert lats == {lat}, f"latencies {sorted(lats)[:6]}, expected {lat}"
     first_in = sent[0]
     last_out = outs[-1][0]
-    write_report(cfg, dict(frames=len(pairs), pixels_compared=compared, beats_out=len(got), latency=lat,
+    write_report(cfg, dict(frames=len(pairs), pixels_compared=compared, beats_out=len(got), frame_beats_out=len(pix),
+                           latency=lat,
                            first_in=first_in, last_out=last_out, beats_in=len(sent),
                            features=[int(asm[c].frames[i].astype(bool).sum()) for i in range(len(pairs))
                                      for c in (0, 1)]))
