@@ -76,8 +76,8 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
     depth = check_int("depth", depth, 4, 64)
     if depth & (depth - 1):
         raise block_error(f"parameter depth={depth} must be a power of two")
-    if 2 * border >= min(width, height):
-        raise block_error(f"parameter border={border} leaves no pixel inside a {width}x{height} frame")
+    if 2 * border > min(width, height):
+        raise block_error(f"parameter border={border} is more than half of a {width}x{height} frame")
     cb = count_bits(width, height)
     ab = addr_bits((bxn, byn))
     check_signal("count_addr", count_addr, width=ab, signed=False)

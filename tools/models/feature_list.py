@@ -38,8 +38,8 @@ TOKEN_WORD = (0, False, True)
 
 
 def check_params(width: int, height: int, border: int, max_features: int) -> None:
-    if not 1 <= border or 2 * border >= min(width, height):
-        raise ValueError(f"parameter border={border}: must be at least 1 and leave pixels inside a {width}x{height} frame")
+    if not 1 <= border or 2 * border > min(width, height):
+        raise ValueError(f"parameter border={border}: must be at least 1 and at most half of a {width}x{height} frame")
     if not 1 <= max_features <= MAX_FEATURES:
         raise ValueError(f"parameter max_features={max_features}: must be 1..{MAX_FEATURES} (15-bit count)")
 
