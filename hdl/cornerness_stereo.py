@@ -127,7 +127,7 @@ def cornerness_stereo(clk, rst, sink, source, k_left, k_right, *, share: int = 1
             p1.next = p0
 
         @always_comb
-        def select():
+        def choose_operands():
             if p1:
                 ma.next = c
                 mb.next = c
@@ -162,7 +162,7 @@ def cornerness_stereo(clk, rst, sink, source, k_left, k_right, *, share: int = 1
             cr.next = det - (ktt << 2)
             source.data.next = cout[nb:]
 
-        insts += [phases, select, multiply, products, difference, finish]
+        insts += [phases, choose_operands, multiply, products, difference, finish]
     for s, d in ((sink.valid, source.valid), (sink.eol, source.eol), (sink.eof, source.eof), (sink.cam, source.cam)):
         insts.append(delay_rst(clk, rst, s, d, clocks=lat))
     return insts

@@ -115,7 +115,7 @@ def harris_window_stereo(clk, rst, sink, source, *, width: int = 352, height: in
         s0 = range_signal((-big + 16) >> 5, (big + 16) >> 5)
 
         @always_comb
-        def select():
+        def choose_operands():
             if p1:
                 b0.next = opy
             else:
@@ -135,14 +135,14 @@ def harris_window_stereo(clk, rst, sink, source, *, width: int = 352, height: in
             if p1:
                 qxy.next = s0
 
-        insts += [select, multiply, cut]
+        insts += [choose_operands, multiply, cut]
     else:
         a0, b0 = fx_signal(sfix(10)), fx_signal(sfix(10))
         f0 = range_signal(-big + 16, big + 16)
         s0 = range_signal((-big + 16) >> 5, (big + 16) >> 5)
 
         @always_comb
-        def select():
+        def choose_operands():
             if p1:
                 a0.next = opy
             else:
@@ -166,7 +166,7 @@ def harris_window_stereo(clk, rst, sink, source, *, width: int = 352, height: in
             if p2:
                 qxy.next = s0
 
-        insts += [select, multiply, cut]
+        insts += [choose_operands, multiply, cut]
 
     prod = ImageStream(model.PRODUCTS, stereo=True)
     insts.append(pack_word(prod.data, model.PRODUCTS, pxx=qxx, pyy=qyy, pxy=qxy))
