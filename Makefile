@@ -83,6 +83,7 @@ bench: setup
 	$(PY) -m eyestereo.sim.bench_sram --out docs/sram.md
 	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.tools.reports.rectifier_precision
 	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.sim.bench_warper
+	$(PY) -m eyestereo.sim.bench_harris_stereo --out docs/harris_stereo.md --shared $(SHARED)
 
 clean:
 	rm -rf build .pytest_cache .hypothesis
