@@ -11,6 +11,7 @@ from eyestereo.hdl.harris_window_stereo import harris_window_stereo
 from eyestereo.hdl.harris_window_stereo import latency as window_latency
 from eyestereo.hdl.harris_window_stereo import multipliers as window_multipliers
 from eyestereo.hdl.nms_stereo import latency as nms_latency
+from eyestereo.hdl.nms_stereo import lead as nms_lead
 from eyestereo.hdl.nms_stereo import nms_stereo
 from eyestereo.hdl.prethreshold_stereo import prethreshold_stereo
 from eyestereo.hdl.sobel import LATENCY as SOBEL_LATENCY
@@ -24,9 +25,12 @@ from eyestereo.tools.models.harris_stereo import SHARES
 from eyestereo.tools.models.prethreshold import check_blocks
 
 
-def latency(nms: int, share: int) -> tuple[int, int]:
-    """(clocks, window lead r): camera c's flag (x, y) comes that many clocks after its input pixel (x + r, y + r)."""
-    return (SOBEL_LATENCY + window_latency(share) + corner_latency(share) + 1 + nms_latency(nms), radius(nms))
+def latency(nms: int, share: int) -> tuple[int, int, int]:
+    """(clocks, lines, pixels): camera c's flag (x, y) comes that many clocks after its input beat of pixel
+    (x + pixels, y + lines): Sobel 1 + window 2 + the NMS's :func:`~eyestereo.hdl.nms_stereo.lead`."""
+    lines, pixels = nms_lead(nms)
+    return (SOBEL_LATENCY + window_latency(share) + corner_latency(share) + 1 + nms_latency(nms),
+            3 + lines, 3 + pixels)
 
 
 def multipliers(share: int) -> int:
@@ -69,11 +73,12 @@ def harris_stereo(clk, rst, sink, source, k_left, k_right, thr_we, thr_cam, thr_
         nms: 1, 3 or 5: non-maximum suppression window.
         share: 1, 2 or 3 (default 3, the thesis's design): clocks per beat the multipliers are shared over.
 
-    Latency: :func:`latency` clocks after the camera's input pixel (x + r, y + r) (r lines + r pixels of
-    that camera: 2 (r width + r) beats); share 3, nms 3: 4 lines + 4 pixels + 27 clocks.
+    Latency: :func:`latency`: flag (x, y) comes a constant number of clocks after the camera's input
+    pixel (x + 3 + p, y + 3 + l) (nms 3: l = 1, p = 2; nms 1: 0, 0; nms 5: 2, 2); share 3, nms 3:
+    4 lines + 5 pixels of the camera (2 (4 width + 5) beats) + 24 clocks.
 
-    Resources: 4 + 2 (nms - 1) stereo line delays (2 Sobel, 4 window, nms - 1 NMS: 12 RAMB16 at 352
-    wide for nms 3), :func:`multipliers` MULT18X18; see docs/harris_stereo.md.
+    Resources: stereo line delays: 2 Sobel (1 RAMB16 each), 4 window (2 each), 1 NMS 3x3 (2) -- 12
+    RAMB16 at 352 wide for nms 3; :func:`multipliers` MULT18X18; see docs/harris_stereo.md.
     """
     nb = corner_model.OUT.wl
     check_clock(clk)

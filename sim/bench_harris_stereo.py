@@ -116,12 +116,12 @@ def run_sim(shared: Path, shares) -> dict:
     return out
 
 
-def run_synth(shares) -> dict:
+def run_synth(shares, stages=None) -> dict:
     from eyestereo.hdl.synth import synth_block
 
     register_stages()
     out = {}
-    jobs = [(n, n, {}) for n in TABLE_6_4]
+    jobs = [(n, n, {}) for n in TABLE_6_4 if stages is None or n in stages]
     jobs += [(f"harris_stereo share {s}", "harris_stereo", dict(share=s)) for s in shares]
     for label, name, params in jobs:
         t0 = time.perf_counter()
@@ -214,6 +214,7 @@ def main(argv=None) -> int:
     ap.add_argument("--shares", type=int, nargs="+", default=[1, 2, 3])
     ap.add_argument("--no-sim", action="store_true")
     ap.add_argument("--no-synth", action="store_true")
+    ap.add_argument("--stages", nargs="*", default=None, help="synthesize only these stages (default: all five)")
     a = ap.parse_args(argv)
     BUILD.mkdir(parents=True, exist_ok=True)
     if not a.no_sim:
@@ -222,7 +223,7 @@ def main(argv=None) -> int:
         (BUILD / "sim.json").write_text(json.dumps(sim, indent=1))
     if not a.no_synth:
         syn = _load("synth") or {}
-        syn.update(run_synth(a.shares))
+        syn.update(run_synth(a.shares, a.stages))
         (BUILD / "synth.json").write_text(json.dumps(syn, indent=1))
     text = render(_load("sim"), _load("synth"))
     tmp = a.out.with_suffix(".tmp")

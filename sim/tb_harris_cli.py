@@ -43,7 +43,7 @@ async def harris_cli(dut):
         await ClockCycles(dut.clk, 4096)
         with open(progress, "w") as f:
             f.write(str(total - len(source.queue)))
-    await ClockCycles(dut.clk, 2 * (8 * w + 8) * share + 400)
+    await ClockCycles(dut.clk, 2 * (8 * w + 8) * share + 400)  # more than any tail (5 lines + 5 pixels)
     with open(progress, "w") as f:
         f.write(str(total))
     asm, _ = split_cameras(monitor.beats, w, h)

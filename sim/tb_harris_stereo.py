@@ -125,9 +125,10 @@ async def harris_stereo_frames(dut):
     while source.queue and waited < limit:
         await ClockCycles(dut.clk, 256)
         waited += 256
-    lat, r = __import__("eyestereo.hdl.harris_stereo", fromlist=["latency"]).latency(nms, share)
-    # the tail of the last frame: r lines + r pixels per camera at one beat every share clocks
-    await ClockCycles(dut.clk, lat + 2 * (r * w + r) * share + 200)
+    lat, ll, lp = __import__("eyestereo.hdl.harris_stereo", fromlist=["latency"]).latency(nms, share)
+    r = radius(nms)
+    # the tail of the last frame: ll lines + lp pixels per camera at one beat every share clocks
+    await ClockCycles(dut.clk, lat + 2 * (ll * w + lp) * share + 200)
     assert not source.queue, "the source still holds beats (timeout)"
 
     got = monitor.beats
@@ -160,7 +161,7 @@ async def harris_stereo_frames(dut):
             compared += int(mask.sum())
     assert compared > 0
 
-    # Latency of every specified flag: its beat against the input beat of (x + r, y + r) of its camera.
+    # Latency of every specified flag: its beat against the input beat of (x + lp, y + ll) of its camera.
     sent = source.sent_cycles[first_frame_beat:]
     outs = pix
     lats = set()
@@ -170,13 +171,15 @@ async def harris_stereo_frames(dut):
             for x in range(r, w - r):
                 for cam in (0, 1):
                     o = outs[f * per_frame + 2 * (y * w + x) + cam][0]
-                    i = sent[f * per_frame + 2 * ((y + r) * w + x + r) + cam]
+                    if y + ll >= h or x + lp >= w:
+                        continue  # decided by the tail, after the frame's last input
+                    i = sent[f * per_frame + 2 * ((y + ll) * w + x + lp) + cam]
                     lats.add(o - i)
     assert lats == {lat}, f"latencies {sorted(lats)[:6]}, expected {lat}"
     first_in = sent[0]
     last_out = outs[-1][0]
     write_report(cfg, dict(frames=len(pairs), pixels_compared=compared, beats_out=len(got), frame_beats_out=len(pix),
-                           latency=lat,
+                           latency=lat, lead=[ll, lp],
                            first_in=first_in, last_out=last_out, beats_in=len(sent),
                            features=[int(asm[c].frames[i].astype(bool).sum()) for i in range(len(pairs))
                                      for c in (0, 1)]))

@@ -91,7 +91,7 @@ def pair_chain(clk, en, first, regs):
 
 @block
 def stereo_window_control(clk, rst, sink, source, *, width: int, height: int, radius: int, latency: int,
-                          share: int):
+                          share: int, lead_pixels: int | None = None):
     """Control unit for border treatment option 3 on stereo streams: drives ``source.valid/eol/eof/cam``.
 
     The data path puts camera c's output pixel (x, y) on ``source.data`` exactly ``latency`` clocks after
@@ -111,7 +111,9 @@ def stereo_window_control(clk, rst, sink, source, *, width: int, height: int, ra
     radius = check_int("radius", radius, 0)
     latency = check_int("latency", latency, 1)
     share = check_int("share", share, 1, 3)
-    lead = 2 * (radius * width + radius)  # beats
+    # lead_pixels: a data path that decides pixel (x, y) later than at input (x + r, y + r) (nms_stereo's
+    # one-delay 3x3 form: at (x + 2, y + 1), i.e. width + 2 pixels behind)
+    lead = 2 * (radius * width + radius if lead_pixels is None else check_int("lead_pixels", lead_pixels, 0))
     if lead // 2 >= width * height:
         raise block_error(f"a {2 * radius + 1}x{2 * radius + 1} window needs a frame larger than {width}x{height}")
     skip = Signal(intbv(lead, min=0, max=lead + 1))
