@@ -145,6 +145,32 @@ def render(sim: dict | None, synth: dict | None) -> str:
              "per camera. `feature_list` turns its flags into feature words. Block documentation: the docstrings of "
              "`hdl/harris_stereo.py` and `hdl/feature_list.py`; the feature word format: "
              "`eyestereo.tools.models.feature_list`.", ""]
+    lines += ["## Design", "",
+              "* **Line delays shared by the cameras.** The thesis packs the left and right pixel into one block-RAM "
+              "word (serial-to-parallel). Here each line delay is a stereo `line_delay`: 2 x width words addressed "
+              "by (column, cam), the left and right words of a column side by side. The block RAMs are the same "
+              "(2 x 352 x 8 bits: one RAMB16 for a Sobel delay; 2 x 352 x 36 bits: two for a window delay), and the "
+              "datapath stays one camera wide: no pair of Sobel or window adders, no multiplexer between two "
+              "halves of a word. The horizontal registers become chains of 2N - 1, read every other one.",
+              "* **Multipliers shared over `share` clocks.** Beats come at least `share` clocks apart, so each "
+              "product unit holds its operands and runs its products in phases: the window's Ix^2, Iy^2, IxIy on "
+              "3 / 2 / 1 multipliers, the cornerness's a*b with k*t, then c*c with (k t >> 8)*t on 2 (4 at share "
+              "1). The arithmetic and its formats are the mono blocks', so the codes are the same.",
+              "* **Tails at the input's pace.** After a frame, each window stage emits its missing rows itself, "
+              "one beat every `share` clocks, so a shared multiplier behind it never sees two beats closer "
+              "than `share` clocks.",
+              "* **NMS 3x3 with one line delay.** Values are clamped at 0 (no flag changes: a centre must be > 0 and "
+              "a neighbour <= 0 loses to it under > and >=), and each row's words carry the flag \"beats the "
+              "three pixels above\" (the strict rule for rows above), formed when that row meets the row above at "
+              "the line delay's output; one row later the delay returns value and flag together. One 20-bit "
+              "stereo line delay (2 RAMB16) instead of two (4).",
+              "* **Thresholds and k per camera.** One LUT-RAM of 2 x BX x BY thresholds addressed by (block, cam), "
+              "written through `thr_we/thr_cam/thr_addr/thr_data`; `k_left`/`k_right` inputs.",
+              "* **Feature lists** (`feature_list`, format in `eyestereo.tools.models.feature_list`): per feature "
+              "two 16-bit words, (x | cam << 15) then y; per frame a trailer (0xFFFF, count | overflow << 15) "
+              "with `eol`/`eof`; a reset token aborts a list with the queue's reset token; at most "
+              "`max_features` per list (the overflow flag says the list was cut); counts per (camera, "
+              "threshold block) in two LUT-RAM banks, published at each frame's end with `frame_done`.", ""]
     lines += ["## Full 352x288 stereo frames on GHDL, bit for bit", ""]
     if sim:
         lines += ["Each camera's flags equal the `harris_mono` model of that camera's frame with that camera's k "
@@ -160,10 +186,10 @@ def render(sim: dict | None, synth: dict | None) -> str:
         lines += ["", "## Throughput and latency", "",
                   "Measured in the same runs: beats in per clock from the first beat in to the last flag out (the "
                   "pairs back to back, so the last pair's tail is included), and the latency of every specified "
-                  "flag, from the input beat of its camera's pixel (x + r, y + r) (r = 4 for nms 3) to the flag "
-                  "(x, y): the bench asserts it is the same constant for all of them and equals "
-                  "`harris_stereo.latency(nms, share)`.", "",
-                  "| share | multipliers | beats per clock (measured) | stereo pixels per clock | at 50 MHz | latency (clocks after pixel (x+4, y+4)) | = |",
+                  "flag, from the input beat of its camera's pixel (x + 5, y + 4) (nms 3: the beat that completes "
+                  "the flag's window) to the flag (x, y): the bench asserts it is the same constant for all of them "
+                  "and equals `harris_stereo.latency(nms, share)`.", "",
+                  "| share | multipliers | beats per clock (measured) | stereo pixels per clock | at 50 MHz | latency (clocks after pixel (x+5, y+4)) | = |",
                   "|---:|---:|---:|---:|---|---:|---|"]
         for s, r in sorted(sim.items()):
             s = int(s)
@@ -172,10 +198,11 @@ def render(sim: dict | None, synth: dict | None) -> str:
             lat = r["latency"]
             lines.append(f"| {s} | {multipliers(s)} | {bpc:.4f} (limit {1 / s:.4f}) | {bpc / 2:.4f} | "
                          f"{50 * bpc / 2:.2f} M stereo pixels/s, {fps:.0f} stereo frames/s | {lat} | "
-                         f"4 lines + 4 pixels of the camera (2 x 1412 beats) + {lat} clocks |")
-        lines += ["", "Each camera's flag of pixel (x, y) therefore leaves 2 (4 x 352 + 4) beats + latency after its "
-                  "own pixel (x, y) entered: at share 3 and full rate 8472 + "
-                  f"{sim.get('3', sim.get(3, {})).get('latency', '?')} clocks (170 us at 50 MHz).", ""]
+                         f"4 lines + 5 pixels of the camera (2 x 1413 beats) + {lat} clocks |")
+        l3 = sim.get("3", {}).get("latency")
+        if l3 is not None:
+            lines += ["", "At share 3 and full rate a flag (x, y) therefore leaves 3 x 2 x (4 x 352 + 5) = 8478 + "
+                      f"{l3} clocks after its own pixel (x, y) entered ({(8478 + l3) / 50:.0f} us at 50 MHz).", ""]
     else:
         lines += ["(not run: `--no-sim`)", ""]
     lines += ["## Resources (thesis Table 6.4 beside them)", ""]
@@ -211,7 +238,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m eyestereo.sim.bench_harris_stereo", description=__doc__.split("\n")[0])
     ap.add_argument("--out", type=Path, required=True)
     ap.add_argument("--shared", type=Path, default=ROOT.parent / "shared" / "data")
-    ap.add_argument("--shares", type=int, nargs="+", default=[1, 2, 3])
+    ap.add_argument("--shares", type=int, nargs="*", default=[1, 2, 3])
     ap.add_argument("--no-sim", action="store_true")
     ap.add_argument("--no-synth", action="store_true")
     ap.add_argument("--stages", nargs="*", default=None, help="synthesize only these stages (default: all five)")
