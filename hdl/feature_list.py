@@ -60,7 +60,8 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
         max_features: 1..32767 features per list (default 1023: 2048 words with the trailer).
         depth: FIFO entries, a power of two 4..64.
 
-    Latency: a feature's first word is on ``source`` 3 clocks after its flag (FIFO empty, ``ready`` high).
+    Latency: a feature's first word is on ``source`` 2 clocks after its flag (FIFO empty, ``ready`` high;
+    measured by the bench).
     Throughput: one word per clock, one feature per 2 clocks sustained; the FIFO absorbs bursts.
 
     Resources: the FIFO (34 x depth LUT-RAM), 2 x 2 x BX BY counters in LUT-RAM, position counters.

@@ -47,6 +47,7 @@ class Consumer:
         self.ready = ready
         self.rng = random.Random(seed)
         self.words: list[tuple] = []
+        self.cycles: list[int] = []  # cycle each word was on the port (taken at the next edge)
         self.undefined: list[str] = []
         dut.source_ready.value = 0
         cocotb.start_soon(self._run())
@@ -68,6 +69,9 @@ class Consumer:
                     self.undefined.append(f"word {len(self.words)} undefined: {d} {l} {f}")
                     continue
                 self.words.append((int(d), bool(int(l)), bool(int(f))))
+                from cocotb.utils import get_sim_time
+
+                self.cycles.append(int(get_sim_time(unit="ns") // PERIOD_NS))
 
 
 @cocotb.test()
@@ -157,6 +161,16 @@ async def feature_list_frames(dut):
         assert pub["overflow"] == int(res["overflow"]), f"frame {i}: overflow {pub['overflow']}"
         assert (pub["counts"] == res["counts"]).all(), f"frame {i}: counts {pub['counts'].tolist()} != {res['counts'].tolist()}"
     lists = model.parse_words(got)
-    write_report(cfg, dict(frames=len(pairs), words=len(got), lists=len(lists),
+    # Latency of the first feature of the first whole frame (FIFO empty, consumer ready): the cycle its
+    # first word is on the port minus the cycle its flag's beat was driven.
+    latency = None
+    first = results[0]["features"]
+    if first and cfg.get("ready", 1.0) >= 1.0:
+        x, y, cam = first[0]
+        n_before = len(beats) - sum(2 * f.size for f in (p_[0] for p_ in pairs))
+        beat_index = n_before + 2 * (y * w + x) + cam
+        word_index = len(expected_words) - sum(len(r["words"]) for r in results)
+        latency = consumer.cycles[word_index] - source.sent_cycles[beat_index]
+    write_report(cfg, dict(frames=len(pairs), words=len(got), lists=len(lists), latency=latency,
                            features=[len(r["features"]) for r in results],
                            overflow=[bool(r["overflow"]) for r in results]))

@@ -28,3 +28,5 @@ def test_feature_list(request, duty, ready, max_features, blocks, depth):
     assert sum(report["features"]) > 0
     if max_features < 40:
         assert any(report["overflow"])
+    if ready == 1.0:
+        assert report["latency"] == 2  # as the block's docstring says
