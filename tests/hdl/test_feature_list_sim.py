@@ -30,3 +30,13 @@ def test_feature_list(request, duty, ready, max_features, blocks, depth):
         assert any(report["overflow"])
     if ready == 1.0:
         assert report["latency"] == 2  # as the block's docstring says
+
+
+def test_feature_list_consumer_stall_drops_and_flags(request):
+    """Dense flags at full rate and a consumer taking a word every ~5 clocks: the FIFO overflows; the
+    lists keep the model's order with features left out and the overflow flag set, the counts stay exact."""
+    report = run_bench("feature_list", "tb_feature_list",
+                       dict(frames=["flags:0.3", "flags:0.3"], duty=1.0, ready=0.2, seed=4, lossy=True),
+                       name=request.node.name,
+                       params=dict(width=23, height=13, blocks=(2, 2), border=3, max_features=1023, depth=4))
+    assert report["frames"] == 2 and all(report["overflow"])
