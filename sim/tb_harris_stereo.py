@@ -40,8 +40,9 @@ class SpacedIdle:
         self.since = share
 
     def __call__(self) -> bool:
+        # called once per clock while beats wait: ``since`` = clocks since the last beat, this one included
         ok = self.since >= self.share and (self.duty >= 1.0 or self.rng.random() < self.duty)
-        self.since = 0 if ok else self.since + 1
+        self.since = 1 if ok else self.since + 1
         return ok
 
 
