@@ -88,6 +88,7 @@ bench: setup
 	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.tools.reports.rectifier_precision
 	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.sim.bench_warper
 	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.sim.bench_rectifier
+	$(PY) -m eyestereo.sim.bench_harris_stereo --out docs/harris_stereo.md --shared $(SHARED)
 
 clean:
 	rm -rf build .pytest_cache .hypothesis

@@ -22,6 +22,8 @@ from eyestereo.hdl.axis_to_stream import axis_to_stream
 from eyestereo.hdl.convolve import convolve
 from eyestereo.hdl.cornerness import cornerness
 from eyestereo.hdl.harris_mono import harris_mono
+from eyestereo.hdl.harris_stereo import harris_stereo
+from eyestereo.hdl.feature_list import addr_bits, count_bits, feature_list
 from eyestereo.hdl.harris_window import harris_window
 from eyestereo.hdl.nms import nms
 from eyestereo.hdl.prethreshold import prethreshold
@@ -217,6 +219,14 @@ def _build_rectifier(p):
 
 _RECT_DEFAULTS = dict(_POLY_DEFAULTS, depth=DEFAULT_DEPTH)
 
+def _build_feature_list(p):
+    cb = count_bits(p["width"], p["height"])
+    return dict(clk=Signal(bool(0)), rst=_rst(), sink=ImageStream(1, stereo=True), source=QueuePort(16),
+                count_addr=Signal(intbv(0)[addr_bits(p["blocks"]):]), count_data=Signal(intbv(0)[cb:]),
+                total_left=Signal(intbv(0)[cb:]), total_right=Signal(intbv(0)[cb:]), overflow=Signal(bool(0)),
+                frame_done=Signal(bool(0)))
+
+
 BLOCKS: dict[str, BlockSpec] = {
     "line_delay": BlockSpec(
         "line_delay", "one-line FIFO in block RAM: pixel (x, y-1) at (x, y)", line_delay,
@@ -273,6 +283,20 @@ BLOCKS: dict[str, BlockSpec] = {
         sink_width=lambda p: 8, source_width=lambda p: nms_model.WORD.width,
         hw_params=("width", "height", "blocks", "nms"),
         control=(("k", _k_port),) + _thr_ports()),
+    "harris_stereo": BlockSpec(
+        "harris_stereo", "stereo Harris corners: one datapath for both cameras, shared line delays and "
+        "multipliers (share 1/2/3), k and block thresholds per camera", harris_stereo,
+        dict(width=352, height=288, blocks=(4, 4), nms=3, share=3, stereo=True),
+        sink_width=lambda p: 8, source_width=lambda p: nms_model.WORD.width,
+        hw_params=("width", "height", "blocks", "nms", "share"),
+        control=(("k_left", _k_port), ("k_right", _k_port), _thr_ports()[0],
+                 ("thr_cam", lambda p: Signal(bool(0))), *_thr_ports()[1:])),
+    "feature_list": BlockSpec(
+        "feature_list", "stereo corner flags -> feature words (x, y, cam) on a 16-bit queue port, counts per "
+        "camera and threshold block, a maximum per frame with an overflow flag", feature_list,
+        dict(width=352, height=288, blocks=(4, 4), border=4, max_features=1023, depth=16),
+        sink_width=lambda p: 1, source_width=lambda p: 16,
+        hw_params=("width", "height", "blocks", "border", "max_features", "depth"), build=_build_feature_list),
     "stream_checker": BlockSpec(
         "stream_checker", "protocol checker: lines/frames of the wrong size, stereo interleaving; sticky error "
         "and fault code; optional repair (broken frames become reset tokens)", stream_checker,

@@ -34,18 +34,21 @@ Timing of a 4x2 frame with idle cycles, then a reset token and the next frame (`
     eof     .    _    _    .    _    _    _    _    _    #    .    #    _
     data    .   0,0  1,0   .   2,0  3,0  0,1  1,1  2,1  3,1   .   tok  0,0
 
-Stereo streams (``ImageStream(n, stereo=True)``) carry two frames of one geometry interleaved pixel by
-pixel: left pixel (x, y) with ``cam`` 0, then right pixel (x, y) with ``cam`` 1, each a beat of its own
-(idle cycles allowed anywhere, also between the two beats of a pixel); ``eol`` on both beats of a line's
-last pixel, ``eof`` with ``eol`` on both beats of the frame's last pixel; a reset token with either
-``cam`` resets both sides. A 2x2 stereo frame (``L``/``R`` the camera)::
+Stereo streams (``ImageStream(n, stereo=True)``): two frames of the same geometry, interleaved pixel by
+pixel: left pixel (x, y) with ``cam`` = 0, then right pixel (x, y) with ``cam`` = 1, then (x + 1, y), ...
+``eol`` is high on both beats of a line's last pixel, ``eof`` (with ``eol``) on both beats of the frame's
+last pixel; a reset token (``eof`` high, ``eol`` low) with either ``cam`` resets both sides, also between
+the two beats of a pixel. Idle cycles may come anywhere, between the two beats of a pixel too; a block
+may ask for a minimum spacing of the beats (``harris_stereo``: at least ``share`` clocks apart). Timing
+of a 2x2 stereo frame with idle cycles, then a reset token after a left beat and the next frame
+(``L``/``R`` = ``cam`` 0/1)::
 
-    cycle   0     1     2     3     4     5     6     7     8     9
-    valid   #     #     _     #     #     #     #     _     #     #
-    cam     0     1     .     0     1     0     1     .     0     1
-    eol     _     _     .     #     #     _     _     .     #     #
-    eof     _     _     .     _     _     _     _     .     #     #
-    data   L0,0  R0,0   .    L1,0  R1,0  L0,1  R0,1   .    L1,1  R1,1
+    cycle   0    1    2    3    4    5    6    7    8    9    10   11   12   13
+    valid   #    #    _    #    #    #    #    #    #    _    #    #    #    #
+    cam     _    #    .    _    #    _    #    _    #    .    _    #    _    #
+    eol     _    _    .    #    #    _    _    #    #    .    _    _    _    _
+    eof     _    _    .    _    _    _    _    #    #    .    _    #    _    _
+    data   L0,0 R0,0  .   L1,0 R1,0 L0,1 R0,1 L1,1 R1,1  .   L0,0 tok  L0,0 R0,0
 
 Frame geometry is fixed at elaboration (``width`` x ``height`` parameters of each block). A block's source
 emits frames of the geometry its docstring states (the sink's, for all filters), with the same

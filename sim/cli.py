@@ -6,6 +6,8 @@
                                                      that calibration, analysed by GHDL (--std=93c and 08)
     eyestereo sim rectify DIR LEFT RIGHT -o OUT      DIR/vhdl/ in GHDL on a stereo pair, a memory model on its
                                                      fetch port -> OUT/left.png, right.png, report.json
+    eyestereo sim harris LEFT RIGHT -o OUT           harris_stereo's VHDL in GHDL on a grey pair -> corners.json,
+                                                     overlays (eyestereo.sim.cli_harris)
 
 ``report.json``: the rectified size, ``clocks`` (from ``start`` to the last output beat), ``clocks_per_pixel``
 (per stereo output pixel), ``reads`` and ``reads_per_output_pixel`` (pixels the memory sent, per output
@@ -242,7 +244,7 @@ def register(sub: Any) -> None:
     """Add the simulation commands (and ``rectifier --vhdl``)."""
     if "rectifier" in sub.choices:
         _wrap_rectifier(sub.choices["rectifier"])
-    p = sub.add_parser("sim", help="run generated VHDL in GHDL (rectify)",
+    p = sub.add_parser("sim", help="run generated VHDL in GHDL on your data (rectify, harris)",
                        description="Run the generated hardware in GHDL with cocotb.")
     ss = p.add_subparsers(dest="sim_command", metavar="SIMCOMMAND", required=True, parser_class=type(p))
     r = ss.add_parser("rectify", help="rectify a stereo pair with the rectifier's VHDL in GHDL",
@@ -257,3 +259,6 @@ def register(sub: Any) -> None:
                    help="memory model: answers at once (default) or with random delays and stalls")
     r.add_argument("--seed", type=int, default=1, help="seed of the random memory timing (default 1)")
     r.set_defaults(func=cmd_sim_rectify)
+    from eyestereo.sim.cli_harris import add_harris
+
+    add_harris(ss)

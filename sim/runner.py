@@ -30,12 +30,13 @@ def slug(text: str) -> str:
 
 
 def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict | None = None,
-              waves: bool | None = None, build_root: Path = BUILD) -> dict:
+              waves: bool | None = None, build_root: Path = BUILD, log_file: Path | None = None) -> dict:
     """Convert ``block`` with ``params``, simulate it with cocotb module ``eyestereo.sim.<bench>``.
 
     ``config`` is handed to the bench as JSON (environment variable ``EYESTEREO_TB``); the bench may
     write a JSON report to ``report.json`` in the build folder, which is returned. Raises AssertionError
-    when any cocotb test fails or no test ran.
+    when any cocotb test fails or no test ran. ``log_file``: the simulator's output goes there instead of
+    to stdout (for commands that show their own progress).
     """
     if shutil.which("ghdl") is None:
         raise RuntimeError("ghdl not found: install it (Debian: apt-get install ghdl)")
@@ -50,12 +51,14 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
     full = dict(config, block=block, params=_jsonable(params), report=str(build_dir / "report.json"))
     runner = get_runner("ghdl")
     runner.build(sources=[str(s) for s in sources], hdl_toplevel=block, build_dir=build_dir,
-                 build_args=GHDL_ARGS, always=True, waves=waves)
+                 build_args=GHDL_ARGS, always=True, waves=waves,
+                 log_file=None if log_file is None else str(Path(log_file).with_suffix('.build.log')))
     env = {"EYESTEREO_TB": json.dumps(full),
            "PYTHONPATH": os.pathsep.join([str(SIM_DIR), os.environ.get("PYTHONPATH", "")])}
     results = runner.test(hdl_toplevel=block, hdl_toplevel_lang="vhdl", test_module=f"eyestereo.sim.{bench}",
                           build_dir=build_dir, test_dir=build_dir, test_args=GHDL_ARGS, extra_env=env,
-                          plusargs=GHDL_RUN_OPTIONS, waves=waves)
+                          plusargs=GHDL_RUN_OPTIONS, waves=waves,
+                          log_file=None if log_file is None else str(log_file))
     n_tests, n_failed = get_results(results)
     assert n_tests > 0, f"no cocotb test ran for {block}/{name}"
     assert n_failed == 0, f"{n_failed} of {n_tests} cocotb tests failed for {block}/{name} (see {build_dir})"
