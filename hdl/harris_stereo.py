@@ -75,10 +75,13 @@ def harris_stereo(clk, rst, sink, source, k_left, k_right, thr_we, thr_cam, thr_
 
     Latency: :func:`latency`: flag (x, y) comes a constant number of clocks after the camera's input
     pixel (x + 3 + p, y + 3 + l) (nms 3: l = 1, p = 2; nms 1: 0, 0; nms 5: 2, 2); share 3, nms 3:
-    4 lines + 5 pixels of the camera (2 (4 width + 5) beats) + 24 clocks.
+    4 lines + 5 pixels of the camera (2 (4 width + 5) beats) + 25 clocks (measured by the benches).
 
     Resources: stereo line delays: 2 Sobel (1 RAMB16 each), 4 window (2 each), 1 NMS 3x3 (2) -- 12
-    RAMB16 at 352 wide for nms 3; :func:`multipliers` MULT18X18; see docs/harris_stereo.md.
+    RAMB16 at 352 wide for nms 3; :func:`multipliers` MULT18X18. Measured (make synth's flow, Yosys
+    xc3se, 352x288, 4x4, nms 3): share 3: 1539 LUT + 40 LUT-RAM, 2023 FF, 12 RAMB16, 3 MULT18X18, 85 MHz
+    on ECP5 (thesis Table 6.4: 3473 LUT, 12, 3); share 2: 1526 / 12 / 4; share 1: 1464 / 12 / 7;
+    per module in docs/harris_stereo.md.
     """
     nb = corner_model.OUT.wl
     check_clock(clk)
