@@ -14,6 +14,9 @@ Each JSON file carries, besides WaveDrom's ``signal``/``head``/``config``, an ``
     where the ASCII diagram lives: ``"module"`` or ``"module:object"`` whose docstring has a literal
     block (after ``::``) with a ``cycle`` line, e.g. ``"eyestereo.hdl.stream"``; the diagram in the
     docs is read from there, so the two stay one;
+``ascii_contains``
+    optional, with ``ascii``: take the first such block that contains this text (a docstring with
+    several diagrams, e.g. ``"cam"`` for the stereo stream's in ``eyestereo.hdl.stream``);
 ``ascii_lines``
     instead of ``ascii``, for a contract whose interface class does not exist yet (from INTERFACES.md):
     the ASCII diagram itself;
@@ -95,8 +98,9 @@ def render(d: dict) -> str:
     return svg
 
 
-def ascii_block(doc: str) -> str:
-    """The literal block (after ``::``) of a docstring that contains a ``cycle`` line, dedented."""
+def ascii_block(doc: str, contains: str | None = None) -> str:
+    """The first literal block (after ``::``) of a docstring that contains a ``cycle`` line (and
+    ``contains``, when given), dedented."""
     lines = doc.splitlines()
     for i, line in enumerate(lines):
         if not line.rstrip().endswith("::"):
@@ -109,7 +113,7 @@ def ascii_block(doc: str) -> str:
                 break
             block.append(l)
         text = "\n".join(block).strip("\n")
-        if re.search(r"^\s*cycle\b", text, re.M):
+        if re.search(r"^\s*cycle\b", text, re.M) and (contains is None or contains in text):
             indent = min(len(l) - len(l.lstrip()) for l in text.splitlines() if l.strip())
             return "\n".join(l[indent:] for l in text.splitlines())
     raise TimingError("no literal block with a 'cycle' line in the docstring")
@@ -127,7 +131,7 @@ def ascii_for(meta: dict) -> tuple[str, str]:
     except (ImportError, AttributeError) as e:
         raise TimingError(f"ASCII source {meta['ascii']!r} does not resolve: {e}") from None
     try:
-        return ascii_block(target.__doc__ or ""), f"docstring of `{meta['ascii']}`"
+        return ascii_block(target.__doc__ or "", meta.get("ascii_contains")), f"docstring of `{meta['ascii']}`"
     except TimingError as e:
         raise TimingError(f"{meta['ascii']}: {e}") from None
 

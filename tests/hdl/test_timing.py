@@ -57,3 +57,12 @@ def test_ascii_block_takes_the_cycle_diagram():
     assert ascii_block(doc) == "cycle  0  1\nvalid  _  #"
     with pytest.raises(TimingError):
         ascii_block("no diagram here")
+
+
+def test_ascii_block_picks_the_diagram_that_contains_a_text():
+    doc = ("Mono::\n\n    cycle  0  1\n    valid  _  #\n\nStereo::\n\n    cycle  0  1\n    valid  #  #\n"
+           "    cam    _  #\n\nAfter.\n")
+    assert ascii_block(doc) == "cycle  0  1\nvalid  _  #"
+    assert ascii_block(doc, "cam") == "cycle  0  1\nvalid  #  #\ncam    _  #"
+    with pytest.raises(TimingError):
+        ascii_block(doc, "tready")

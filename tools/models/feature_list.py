@@ -12,6 +12,17 @@ The feature words (the interface of the SRAM feature writer, ``sram_arbiter``'s 
 * a reset token on the flags aborts the list in progress: one queue word with ``eof`` high, ``eol`` low
   (the queue's reset token) ends it, and the next list starts with the next frame.
 
+Timing on the queue port: two features, (x0, y0) of the left camera and (x1, y1) of the right one,
+then the trailer of a list of 2 (``#`` high, ``_`` low, ``.`` don't care; a word moves on a rising
+edge with ``valid`` and ``ready`` high, the consumer holds the word of cycle 2 back)::
+
+    cycle   0       1     2       3       4     5       6      7
+    valid   #       #     #       #       #     #       #      _
+    ready   #       #     _       #       #     #       #      .
+    data    x0|0    y0    x1|1<<15 x1|1<<15 y1  0xFFFF  2      .
+    eol     _       _     _       _       _     _       #      .
+    eof     _       _     _       _       _     _       #      .
+
 Order: the stream order of the flags, raster order with left before right at each (x, y). Only pixels
 at least ``border`` from every edge count (the detector's flags nearer the border are unspecified).
 A list holds at most ``max_features`` features; the rest are counted but not listed, and the trailer's
