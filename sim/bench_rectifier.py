@@ -310,7 +310,8 @@ def resources(reuse: bool = False) -> list[dict]:
         stat = folder / slug(label) / "stat.txt"
         if reuse:
             if stat.exists():
-                out.append(dict(label=label, block=block, **synth.summarize(synth.parse_stat(stat.read_text()))))
+                out.append(dict(label=label, block=block, revision=_synth_revision(stat),
+                                **synth.summarize(synth.parse_stat(stat.read_text()))))
             continue
         print(f"bench_rectifier: synthesizing {label} ...", flush=True)
         try:
@@ -318,9 +319,15 @@ def resources(reuse: bool = False) -> list[dict]:
         except (FileNotFoundError, RuntimeError, ValueError) as exc:
             print(f"bench_rectifier: skipped {label}: {exc}", file=sys.stderr)
             continue
-        out.append(dict(label=label, block=block, **r["summary"]))
+        out.append(dict(label=label, block=block, revision=_revision(), **r["summary"]))
+        (folder / slug(label) / "revision.txt").write_text(_revision() + "\n")
     (OUT / "resources.json").write_text(json.dumps(out, indent=2, default=str) + "\n")
     return out
+
+
+def _synth_revision(stat: Path) -> str:
+    f = stat.parent / "revision.txt"
+    return f.read_text().strip() if f.exists() else "?"
 
 
 def report_text(res: dict, rs: list[dict]) -> str:
@@ -345,6 +352,11 @@ def report_text(res: dict, rs: list[dict]) -> str:
                      f"{'yes' if r['bit_exact'] else 'NO'} | {r['clocks_per_pixel']:.3f} | {r['reads_per_output_pixel']:.3f} | "
                      f"{r['reads_per_inrange_pixel']:.3f} | 4 | {100 * r['oor_sides'] / (2 * r['width'] * r['height']):.1f} % | "
                      f"{r['wall']:.0f} s | {r.get('revision', '4d75c52')} |")
+        revs = sorted({r.get("revision", "4d75c52") for r in fr})
+        if len(revs) > 1:
+            L += ["", f"HDL revisions {', '.join(revs)}: between them only the form of `fetch_interpolate`'s reuse test "
+                  "changed (one offset subtraction and an unsigned compare instead of a signed difference, for "
+                  "MyHDL's Verilog back end); the 352x288 frames, run on both, gave identical clocks, reads and (bit-exact) streams."]
         L.append("")
     if res["remap"]:
         L += ["Hardware images against OpenCV's `remap` (float32 maps, `INTER_LINEAR`) of the same camera images, "
@@ -390,11 +402,11 @@ def report_text(res: dict, rs: list[dict]) -> str:
     if rs:
         L += ["Resources from make synth's flow (GHDL's netlist of the VHDL, Yosys `synth_xilinx -family xc3se`), "
               "beside the thesis's Table 4.4 (Xilinx ISE):", "",
-              "| block | LUT | LUT-RAM | FF | RAMB16 | MULT18X18 | thesis MULT18X18 | thesis LUT |", "|---|---:|---:|---:|---:|---:|---:|---:|"]
+              "| block | LUT | LUT-RAM | FF | RAMB16 | MULT18X18 | thesis MULT18X18 | thesis LUT | HDL revision |", "|---|---:|---:|---:|---:|---:|---:|---:|---|"]
         for r in rs:
             th = THESIS.get(r.get("block", ""), ("-", "-"))
             L.append(f"| {r.get('label')} | {r.get('LUT', '?')} | {r.get('LUTRAM', 0)} | {r.get('FF', '?')} | "
-                     f"{r.get('RAMB16', 0)} | {r.get('MULT18X18', '?')} | {th[0]} | {th[1]} |")
+                     f"{r.get('RAMB16', 0)} | {r.get('MULT18X18', '?')} | {th[0]} | {th[1]} | {r.get('revision', '?')} |")
         L.append("")
     if FIG.exists():
         L += ["![Fig. 4.12](img/rectifier_fig412.png)", "",
