@@ -289,7 +289,7 @@ def figure(path: Path = FIG, pattern: str = "*640x480*at_once*") -> Path | None:
     for y in range(20, img.shape[0], 32):
         cv2.line(img, (0, y), (img.shape[1] - 1, y), (0, 0, 255) if y < top.shape[0] else (0, 160, 0), 1)
     path.parent.mkdir(parents=True, exist_ok=True)
-    ok, buf = cv2.imencode(".png", img)
+    ok, buf = cv2.imencode(".png", img, [cv2.IMWRITE_PNG_COMPRESSION, 9])
     if not ok:
         raise RuntimeError("PNG encoding failed")
     tmp = path.with_suffix(".tmp.png")
