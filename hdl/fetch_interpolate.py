@@ -142,8 +142,9 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
     y0, ty = Signal(intbv(0)[iy:]), Signal(intbv(0)[iy:])
     tv = Signal(bool(0))
     dx, dy = Signal(intbv(0)[fw:]), Signal(intbv(0)[fw:])
-    tx1, x01 = Signal(intbv(0)[ix + 1:]), Signal(intbv(0)[ix + 1:])
-    ty1, y01 = Signal(intbv(0)[iy + 1:]), Signal(intbv(0)[iy + 1:])
+    XOFF, YOFF = (1 << (ix + 1)) + 1, (1 << (iy + 1)) + 1
+    ex, ey = Signal(intbv(0)[ix + 2:]), Signal(intbv(0)[iy + 2:])
+    exl, eyl = Signal(intbv(0)[ix + 1:]), Signal(intbv(0)[iy + 1:])
     cx, cy = Signal(intbv(0)[2:]), Signal(intbv(0)[2:])
     code = Signal(intbv(0)[4:])
     rom_mask = Signal(intbv(0)[4:])
@@ -192,30 +193,27 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
             dy.next = yl[fw:0]
 
     @always_comb
-    def plus_one():
-        tx1.next = tx + 1
-        x01.next = x0 + 1
-        ty1.next = ty + 1
-        y01.next = y0 + 1
+    def offsets():
+        # x0 - tx + 1 kept positive by 2**(ix+1): its low ix+1 bits are 0, 1, 2 for ddx = -1, 0, 1 (one
+        # subtraction; no signed values, no negative constants: MyHDL's Verilog compares a signed case
+        # expression with unsigned negative items)
+        ex.next = x0 + XOFF - tx
+        ey.next = y0 + YOFF - ty
+
+    @always_comb
+    def offsets_low():
+        exl.next = ex[ix + 1:0]
+        eyl.next = ey[iy + 1:0]
 
     @always_comb
     def reuse_code():
-        # ddx = x0 - tx in -1..1 by unsigned comparisons only (no negative constants: MyHDL's Verilog
-        # compares a signed case expression with unsigned negative items); 3 = no reuse
-        if x0 == tx:
-            cx.next = 1
-        elif x0 == tx1:
-            cx.next = 2
-        elif x01 == tx:
-            cx.next = 0
+        # 3 = no reuse (the low ix+1 bits are 0..2 only for ddx = -1..1)
+        if exl < 3:
+            cx.next = exl[2:0]
         else:
             cx.next = 3
-        if y0 == ty:
-            cy.next = 1
-        elif y0 == ty1:
-            cy.next = 2
-        elif y01 == ty:
-            cy.next = 0
+        if eyl < 3:
+            cy.next = eyl[2:0]
         else:
             cy.next = 3
 
@@ -491,6 +489,6 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
     def busy_out():
         busy.next = state != IDLE or dcount != 0 or v1 or v2
 
-    return (side, fractions, plus_one, reuse_code, reuse_code2, mask_rom, src_rom, request, request2, requester, queue_mem,
+    return (side, fractions, offsets, offsets_low, reuse_code, reuse_code2, mask_rom, src_rom, request, request2, requester, queue_mem,
             rfifo_mem, rfifo, rfifo_head, unpack, unpack2, step_select, kept_index, kept_read, step_fire,
             weights, multiply_weight, interpolator, keep, rounding, busy_out)

@@ -40,9 +40,9 @@ def test_fetch_interpolate(request, case):
 
 RECT_CASES = {  # calibration, memory, frames
     "rig_at_once": ("rig:32x20", AT_ONCE, 2),
-    "rig_random": ("rig:32x20", RANDOM, 1),
-    "seeded_stalls": ("seed:5:3@24x16", STALLS, 2),
-    "reset_mid_frame": ("rig:24x16", RANDOM, 1),
+    "rig_random": ("rig:24x16", RANDOM, 1),
+    "seeded_stalls": ("seed:5:3@24x16", STALLS, 1),
+    "reset_mid_frame": ("rig:24x16", AT_ONCE, 1),
 }
 
 
