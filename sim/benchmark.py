@@ -134,7 +134,8 @@ def run_case(case, sim_name: str, *, drivers: str = "events") -> dict:
     ppc = n / (recv[2 * n - 1] - recv[n - 1])
     return dict(name=name, block=block, sim=sim_name, drivers=drivers, ppc=float(ppc), lat_min=int(lat.min()),
                 lat_max=int(lat.max()), lead_lines=radius, lead_pixels=radius, cycles=rep["cycles"], wall=wall,
-                sim_s=rep.get("sim_seconds"), compared=rep["pixels_compared"], dump=str(dump))
+                sim_s=rep.get("sim_seconds"), compared=rep["pixels_compared"], dump=str(dump),
+                load=os.getloadavg()[0])
 
 
 def measure(case) -> dict:
@@ -153,7 +154,8 @@ def _rate(cycles, seconds) -> str:
     return f"{cycles / seconds:.0f}" if seconds else "?"
 
 
-def report(results: list[dict], sims: list[str] | None = None, versions: dict | None = None) -> str:
+def report(results: list[dict], sims: list[str] | None = None, versions: dict | None = None,
+           missing: list[str] = ()) -> str:
     """The markdown of the measured results: throughput/latency (GHDL mcode) and speed per simulator."""
     import cocotb
     import myhdl
@@ -165,14 +167,15 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
         pass
     versions = versions or {}
     sims = sims or sorted({r.get("sim", "ghdl-mcode") for r in results})
-    tools = "; ".join(versions.get(k, k) for k in versions) or _version(["ghdl", "--version"])
+    tools = "; ".join(f"{k}: {v}" for k, v in versions.items()) or _version(["ghdl", "--version"])
     out = ["# Benchmarks", "",
            f"Measured by `make bench` ({Path(__file__).name}) on {datetime.date.today()}: {cpu}, "
            f"{platform.python_implementation()} {platform.python_version()}, cocotb {cocotb.__version__}, "
-           f"MyHDL {myhdl.__version__}; {tools}.", "",
+           f"MyHDL {myhdl.__version__}; {tools}.", "", _load_note(results), "",
            "## Throughput, latency (352x288, two frames back to back, 100 % input duty, GHDL on the VHDL)", "",
-           "| block | pixels / clock | latency (clocks) | window lead | clocks simulated | pixels compared bit-exact |",
-           "|---|---:|---:|---|---:|---:|"]
+           "| block | pixels / clock | latency (clocks) | window lead | clocks simulated | pixels compared bit-exact "
+           "| same clocks, pixels / clock and latency on every simulator |",
+           "|---|---:|---:|---|---:|---:|---|"]
     by = {(r["name"], r.get("sim", "ghdl-mcode"), r.get("drivers", "events")): r for r in results}
     names = list(dict.fromkeys(r["name"] for r in results))
     for nm in names:
@@ -182,11 +185,17 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
         lat = str(r["lat_min"]) if r["lat_min"] == r["lat_max"] else f"{r['lat_min']}..{r['lat_max']}"
         n = r["lead_lines"]
         lead = f"{n} line{'s' if n > 1 else ''} + {n} px" if n else "-"
-        out.append(f"| {r['name']} | {r['ppc']:.4f} | {lat} | {lead} | {r['cycles']} | {r['compared']} |")
+        others = [o for k, o in by.items() if k[0] == nm and k[2] == "events"]
+        same = all((o["ppc"], o["lat_min"], o["lat_max"], o["cycles"]) == (r["ppc"], r["lat_min"], r["lat_max"],
+                                                                          r["cycles"]) for o in others)
+        agree = f"yes ({len(others)})" if same and len(others) > 1 else ("-" if same else "**no**")
+        out.append(f"| {r['name']} | {r['ppc']:.4f} | {lat} | {lead} | {r['cycles']} | {r['compared']} | {agree} |")
+    for nm in missing:
+        out.append(f"| {nm} | not measured in this run | | | | | |")
     out += ["", "Latency counts clocks from the input beat of pixel (x + r, y + r), the last one the window "
             "centred on (x, y) needs, to the output beat of (x, y); the output stream therefore runs "
             "r lines + r pixels + that many clocks behind the input. For the line delay it is input "
-            "beat to output beat. Every simulator below gives the same pixels per clock and latencies.", "",
+            "beat to output beat.", "",
             "## Simulation speed per simulator (clocks per second; same stimulus, same run, same machine)", "",
             "GHDL runs the VHDL (mcode and LLVM back ends), Icarus and Verilator MyHDL's Verilog conversion. "
             "Each cell: simulation only (cocotb's time of the test: stimulus, models and checks included) / "
@@ -219,6 +228,17 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
         out.append(f"| {nm} | " + " | ".join(cells) + f" | {gain} | {eq} |")
     out.append("")
     return "\n".join(out)
+
+
+def _load_note(results: list[dict]) -> str:
+    import os
+
+    loads = [r["load"] for r in results if r.get("load") is not None]
+    if not loads:
+        return ""
+    return (f"The machine ({os.cpu_count()} cores) was shared while measuring: 1-minute load average "
+            f"{min(loads):.1f} to {max(loads):.1f} at the end of the runs. Absolute speeds scale with the load; "
+            "the columns of one row were measured in the same run and compare with each other.")
 
 
 def _equal(name: str, results: list[dict]) -> str:
@@ -254,6 +274,8 @@ def main(argv=None) -> int:
     ap.add_argument("--before", default="harris_mono (4x4",
                     help="benches also run with the per-clock drivers of before ('' none, 'all' every bench)")
     ap.add_argument("--resume", action="store_true", help=f"keep the results already in {RESULTS.name}")
+    ap.add_argument("--report-only", action="store_true",
+                    help=f"run nothing: write the report from the results in {RESULTS.name}")
     args = ap.parse_args(argv)
     unknown = [s for s in args.sims.split(",") if s and s not in SIMULATORS]
     if unknown:
@@ -265,7 +287,8 @@ def main(argv=None) -> int:
     if not cases or not sims:
         print("benchmark: nothing to run (no bench or no simulator selected)", file=sys.stderr)
         return 2
-    done = json.loads(RESULTS.read_text())["results"] if (args.resume and RESULTS.exists()) else []
+    keep = args.resume or args.report_only
+    done = json.loads(RESULTS.read_text())["results"] if (keep and RESULTS.exists()) else []
     have = {(r["name"], r["sim"], r["drivers"]) for r in done}
     todo = [(c, s, "events") for c in cases for s in sims]
     if args.before and "ghdl-mcode" in sims:
@@ -274,14 +297,15 @@ def main(argv=None) -> int:
     todo.sort(key=lambda t: 0 if (args.before and args.before != "all" and args.before in t[0][0]) else 1)
     RESULTS.parent.mkdir(parents=True, exist_ok=True)
     for case, sim, drivers in todo:
-        if (case[0], sim, drivers) in have:
+        if (case[0], sim, drivers) in have or args.report_only:
             continue
         print(f"benchmark: {case[0]} on {sim}{' (per-clock drivers)' if drivers == 'clocked' else ''} ...", flush=True)
         done.append(run_case(case, sim, drivers=drivers))
         RESULTS.write_text(json.dumps(dict(results=done), indent=2))
     names = [c[0] for c in cases]
     results = [r for r in done if r["name"] in names and r["sim"] in sims]
-    text = report(results, sims, simulator_versions()) + NOTES + "\n" + synth_section(args.out)
+    missing = [c[0] for c in cases if not any(r["name"] == c[0] for r in results)]
+    text = report(results, sims, simulator_versions(), missing=missing) + NOTES + "\n" + synth_section(args.out)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     tmp = args.out.with_suffix(".tmp")
     tmp.write_text(text)
