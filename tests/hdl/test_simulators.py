@@ -159,7 +159,7 @@ SMALL = [
     ("harris_mono", "tb_harris_mono", dict(width=40, height=30, blocks=(2, 2), nms=5),
      dict(frames=["random:1", "random:2"], duty=0.5, seed=5, k=hm.k_code(0.1), thresholds=[0, 5, 100, -3],
           token_after=90)),
-    ("harris_mono", "tb_harris_mono", dict(width=40, height=30, blocks=(1, 1), nms=1),
+    ("harris_mono", "tb_harris_mono", dict(width=48, height=40, blocks=(1, 1), nms=1),
      dict(frames=["checker:1"], duty=1.0, k=hm.k_code(0.24), thresholds=[13])),
 ]
 
