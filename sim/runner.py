@@ -37,6 +37,8 @@ GHDL_ARGS = ["--std=08"]
 GHDL_RUN_OPTIONS = ["--ieee-asserts=disable"]
 SIMS = ("ghdl", "icarus", "verilator")
 GHDL_BACKENDS = ("mcode", "llvm")
+# LLVM's code generation with optimisation (mcode ignores it): 10-25 % faster harris_mono runs here.
+GHDL_LLVM_ARGS = ["-O2"]
 # MyHDL's Verilog: unread sub-block outputs, width truncations it writes on purpose. Verilator's lint
 # warnings are not errors here; the benches compare every output word with the model.
 VERILATOR_ARGS = ["-Wno-fatal", "-Wno-lint", "-Wno-style", "-O3"]
@@ -154,8 +156,9 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
         if sim == "ghdl":
             sources = convert(block, build_dir, **params)
             runner = get_runner("ghdl")
+            opt = GHDL_LLVM_ARGS if os.environ["GHDL_BACKEND"] == "llvm" else []
             runner.build(sources=[str(s) for s in sources], hdl_toplevel=block, build_dir=build_dir,
-                         build_args=GHDL_ARGS, always=True, waves=waves)
+                         build_args=GHDL_ARGS + opt, always=True, waves=waves)
             results = runner.test(hdl_toplevel=block, hdl_toplevel_lang="vhdl",
                                   test_module=f"eyestereo.sim.{bench}", build_dir=build_dir, test_dir=build_dir,
                                   test_args=GHDL_ARGS, extra_env=env, plusargs=GHDL_RUN_OPTIONS, waves=waves)
