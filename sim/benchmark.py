@@ -73,9 +73,18 @@ BEFORE = "ghdl-mcode, per-clock drivers"
 RESULTS = BUILD.parent / "bench_sims.json"
 
 NOTES = """
-* GHDL's time goes to evaluating MyHDL's many small processes; Python costs a bench little there. On
-  Verilator the design is cheap and Python's wake-ups are most of a bench's time: the stream drivers
-  wake once per beat (source and sink, at the falling edge mid-cycle) and sleep across idle stretches.
+* GHDL's time goes to evaluating MyHDL's many small processes (random-looking data costs it about twice
+  what smooth data does); Python costs a GHDL bench little, so the event-driven stream drivers gain
+  little on GHDL, and GHDL's LLVM back end (-O2) is what makes the VHDL faster. On Verilator the design
+  is cheap and Python's wake-ups are most of a bench's time: the stream drivers wake once per beat
+  (source and sink, at the falling edge mid-cycle) and sleep across idle stretches and while the output
+  is idle.
+* 'equal' compares the output words of all simulators on every pixel of both frames, border pixels
+  included. Before the fix of issue 9, MyHDL's Verilog of `cornerness` computed `det4 - 4 ktt` unsigned
+  (a signed and an unsigned operand: Verilog zero-extends the signed one), so every negative cornerness
+  came out as a large positive one; harris_mono's Verilog flagged 293 corners where the VHDL flags 33
+  on a frame of rendered polygons. `make verilog` now refuses operands of mixed signedness
+  (`eyestereo.hdl.vlint`); the rule is in the README's "How to add a block".
 """
 
 
