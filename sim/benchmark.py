@@ -304,7 +304,11 @@ def main(argv=None) -> int:
     if args.before and "ghdl-mcode" in sims:
         todo += [(c, "ghdl-mcode", "clocked") for c in cases if args.before == "all" or args.before in c[0]]
     # The before/after comparison first: it is the one that needs every simulator of one bench.
-    todo.sort(key=lambda t: 0 if (args.before and args.before != "all" and args.before in t[0][0]) else 1)
+    # The per-clock run right after the same bench's event-driven GHDL mcode run: the machine's load
+    # changes least between the two.
+    order = {("ghdl-mcode", "events"): 0, ("ghdl-mcode", "clocked"): 1}
+    todo.sort(key=lambda t: (0 if (args.before and args.before != "all" and args.before in t[0][0]) else 1,
+                             CASES.index(t[0]), order.get((t[1], t[2]), 2)))
     RESULTS.parent.mkdir(parents=True, exist_ok=True)
     for case, sim, drivers in todo:
         if (case[0], sim, drivers) in have or args.report_only:
