@@ -202,6 +202,9 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
         out.append(f"| {r['name']} | {r['ppc']:.4f} | {lat} | {lead} | {r['cycles']} | {r['compared']} | {agree} |")
     for nm in missing:
         out.append(f"| {nm} | not measured in this run | | | | | |")
+    if missing:
+        out += ["", f"{len(missing)} benches were not run this time (`--cases`, or a run cut short): "
+                "`make bench` runs every bench on every simulator."]
     out += ["", "Latency counts clocks from the input beat of pixel (x + r, y + r), the last one the window "
             "centred on (x, y) needs, to the output beat of (x, y); the output stream therefore runs "
             "r lines + r pixels + that many clocks behind the input. For the line delay it is input "
