@@ -129,13 +129,14 @@ def build_dir_of(block: str, name: str, sim: str | None = None, build_root: Path
 
 
 def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict | None = None,
-              waves: bool | None = None, build_root: Path = BUILD, sim: str | None = None,
-              backend: str | None = None) -> dict:
+              waves: bool | None = None, build_root: Path = BUILD, log_file: Path | None = None,
+              sim: str | None = None, backend: str | None = None) -> dict:
     """Convert ``block`` with ``params``, simulate it with cocotb module ``eyestereo.sim.<bench>``.
 
     ``sim``: ghdl (the VHDL), icarus or verilator (the Verilog conversion); default ``$SIM`` or ghdl.
     ``backend``: GHDL's back end, mcode or llvm (default ``$GHDL_BACKEND`` or mcode; see
-    :func:`fastest_ghdl_backend`).
+    :func:`fastest_ghdl_backend`). ``log_file``: the simulator's output goes there instead of to stdout
+    (the build's to the same name with ``.build.log``; for commands that show their own progress).
     ``config`` is handed to the bench as JSON (environment variable ``EYESTEREO_TB``, with ``sim`` added);
     the bench may write a JSON report to ``report.json`` in the build folder, which is returned with
     ``sim`` and ``sim_seconds`` (cocotb's time of the test itself) added. Raises AssertionError when any
@@ -152,25 +153,28 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
     full = dict(config, block=block, params=_jsonable(params), report=str(build_dir / "report.json"), sim=sim)
     env = {"EYESTEREO_TB": json.dumps(full),
            "PYTHONPATH": os.pathsep.join([str(SIM_DIR), os.environ.get("PYTHONPATH", "")])}
+    logs = {} if log_file is None else dict(log_file=str(Path(log_file).with_suffix(".build.log")))
+    test_log = {} if log_file is None else dict(log_file=str(log_file))
     with _tool_env(sim, backend):
         if sim == "ghdl":
             sources = convert(block, build_dir, **params)
             runner = get_runner("ghdl")
             opt = GHDL_LLVM_ARGS if os.environ["GHDL_BACKEND"] == "llvm" else []
             runner.build(sources=[str(s) for s in sources], hdl_toplevel=block, build_dir=build_dir,
-                         build_args=GHDL_ARGS + opt, always=True, waves=waves)
+                         build_args=GHDL_ARGS + opt, always=True, waves=waves, **logs)
             results = runner.test(hdl_toplevel=block, hdl_toplevel_lang="vhdl",
                                   test_module=f"eyestereo.sim.{bench}", build_dir=build_dir, test_dir=build_dir,
-                                  test_args=GHDL_ARGS, extra_env=env, plusargs=GHDL_RUN_OPTIONS, waves=waves)
+                                  test_args=GHDL_ARGS, extra_env=env, plusargs=GHDL_RUN_OPTIONS, waves=waves,
+                                  **test_log)
         else:
             sources = convert(block, build_dir, hdl="Verilog", **params)
             runner = get_runner(sim)
             kw = dict(build_args=VERILATOR_ARGS) if sim == "verilator" else {}
             runner.build(sources=[str(s) for s in sources], hdl_toplevel=block, build_dir=build_dir,
-                         always=True, waves=waves, timescale=("1ns", "1ps"), **kw)
+                         always=True, waves=waves, timescale=("1ns", "1ps"), **kw, **logs)
             results = runner.test(hdl_toplevel=block, hdl_toplevel_lang="verilog",
                                   test_module=f"eyestereo.sim.{bench}", build_dir=build_dir, test_dir=build_dir,
-                                  extra_env=env, waves=waves)
+                                  extra_env=env, waves=waves, **test_log)
     n_tests, n_failed = get_results(results)
     assert n_tests > 0, f"no cocotb test ran for {block}/{name} on {sim}"
     assert n_failed == 0, (f"{n_failed} of {n_tests} cocotb tests failed for {block}/{name} on {sim} "
