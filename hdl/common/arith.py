@@ -116,3 +116,17 @@ def adder(a, b, s):
         s.next = a + b
 
     return add
+
+
+def signed_copy(sig):
+    """A signed Signal one bit wider than unsigned ``sig``, for ``assign(sig, copy)`` in the caller's block.
+
+    MyHDL's Verilog back end writes ``signed - unsigned`` as it is, and Verilog then computes the whole
+    expression unsigned, zero-extending the signed operand (a negative value turns large and positive);
+    its VHDL back end converts the unsigned operand first. Give such an operator a signed copy of the
+    unsigned operand and both back ends compute the same thing (no logic: a wire with a 0 on top).
+    """
+    lo, hi = signal_range(sig)
+    if lo < 0:
+        raise ValueError("signed_copy: the signal is signed already")
+    return Signal(intbv(0, min=-hi - 1, max=hi + 1))

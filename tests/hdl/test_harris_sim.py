@@ -6,7 +6,7 @@ and two frames back to back; see tests/test_sim.py for what the bench checks.
 
 import pytest
 
-from eyestereo.sim.runner import run_bench
+from eyestereo.sim.runner import fastest_ghdl_backend, run_bench
 from eyestereo.tools.models import harris_mono as hm
 
 pytestmark = pytest.mark.sim
@@ -15,8 +15,13 @@ SMALL = dict(width=23, height=13)
 DUTIES = [1.0, 0.5, 0.1]
 
 
-def _run(block, bench, params, stim, request):
-    report = run_bench(block, bench, stim, name=request.node.name, params=params)
+# Full frames run on GHDL's LLVM back end when it is installed (about twice mcode's speed on these designs;
+# docs/benchmarks.md), the small ones on mcode (no elaboration time).
+FULL = fastest_ghdl_backend()
+
+
+def _run(block, bench, params, stim, request, backend=None):
+    report = run_bench(block, bench, stim, name=request.node.name, params=params, backend=backend)
     assert report["frames"] == len(stim["frames"])
     assert report["pixels_compared"] > 0
     return report
@@ -32,7 +37,7 @@ def test_harris_window_random(request, duty, lim):
 
 def test_harris_window_real_image_full_frame(request):
     _run("harris_window", "tb_harris_window", dict(width=352, height=288),
-         dict(frames=["sobel:file:tsukuba_im3.png"], duty=1.0), request)
+         dict(frames=["sobel:file:tsukuba_im3.png"], duty=1.0), request, backend=FULL)
 
 
 # --- cornerness -----------------------------------------------------------------------------------
@@ -114,21 +119,22 @@ def test_harris_mono_full_frames_4x4_nms3(request):
     """Two real 352x288 frames back to back at full rate, 4x4 blocks with 16 different thresholds."""
     _run("harris_mono", "tb_harris_mono", dict(width=352, height=288, blocks=(4, 4), nms=3),
          dict(frames=["file:tsukuba_im3.png", "file:chessboard_left01.jpg"], duty=1.0, k=K04,
-              thresholds=THR_TSUKUBA, token_after=3000), request)
+              thresholds=THR_TSUKUBA, token_after=3000), request, backend=FULL)
 
 
 def test_harris_mono_full_frame_global_nms5_gaps(request):
     _run("harris_mono", "tb_harris_mono", dict(width=352, height=288, blocks=(1, 1), nms=5),
          dict(frames=["file:chessboard_left01.jpg"], duty=0.6, seed=5, k=hm.k_code(0.06),
-              thresholds=[hm.threshold_code(2e8)]), request)
+              thresholds=[hm.threshold_code(2e8)]), request, backend=FULL)
 
 
 def test_harris_mono_full_frame_nms1(request):
     _run("harris_mono", "tb_harris_mono", dict(width=352, height=288, blocks=(4, 4), nms=1),
-         dict(frames=["file:tsukuba_im3.png"], duty=1.0, k=hm.k_code(0.05), thresholds=THR_TSUKUBA), request)
+         dict(frames=["file:tsukuba_im3.png"], duty=1.0, k=hm.k_code(0.05), thresholds=THR_TSUKUBA), request,
+         backend=FULL)
 
 
 def test_harris_mono_test_pattern_in_hardware(request):
     """The checkerboard test pattern through the VHDL: the same flags as the model, bit for bit."""
     _run("harris_mono", "tb_harris_mono", dict(width=352, height=288, blocks=(1, 1), nms=5),
-         dict(frames=["checker:1"], duty=1.0, k=hm.k_code(0.24), thresholds=[13]), request)
+         dict(frames=["checker:1"], duty=1.0, k=hm.k_code(0.24), thresholds=[13]), request, backend=FULL)
