@@ -6,7 +6,8 @@ from eyestereo.hdl.common.checks import (check_clock, check_distinct, check_int,
                                          check_stream)
 from eyestereo.hdl.common.fixed import fx_signal
 from eyestereo.hdl.common.packed import unpack_word
-from eyestereo.hdl.common.registers import delay_rst
+from eyestereo.hdl.common.arith import signed_copy
+from eyestereo.hdl.common.registers import assign, delay_rst
 from eyestereo.tools.fixed import sfix
 from eyestereo.tools.models import cornerness as model
 from eyestereo.tools.models import harris_window as window_model
@@ -58,6 +59,9 @@ def cornerness_stereo(clk, rst, sink, source, k_left, k_right, *, share: int = 1
     kk = Signal(intbv(0)[model.K.wl:])
     ab, cc, kt = fx_signal(S["ab"]), fx_signal(S["cc"]), fx_signal(S["kt"])
     ktt = fx_signal(S["ktt"])
+    # ktt is unsigned, det signed: the last stage subtracts a signed copy (MyHDL's Verilog would
+    # otherwise compute det - 4 ktt unsigned and turn every negative det positive; README rule 5).
+    ktt_s = signed_copy(ktt)
     cr = fx_signal(S["cr"])
     crs = Signal(intbv(0, min=S["cr"].lo >> model.OUT_SHIFT, max=(S["cr"].hi >> model.OUT_SHIFT) + 1))
     cout = fx_signal(model.OUT)
@@ -92,7 +96,7 @@ def cornerness_stereo(clk, rst, sink, source, k_left, k_right, *, share: int = 1
         else:
             cout.next = crs
 
-    insts = [unpack_word(sink.data, window_model.WORD, sxx=sxx, syy=syy, sxy=sxy), add, stage1, clamp, saturate]
+    insts = [unpack_word(sink.data, window_model.WORD, sxx=sxx, syy=syy, sxy=sxy), add, assign(ktt, ktt_s), stage1, clamp, saturate]
     lat = latency(share)
     if share == 1:
         det, kt8, t2, t3 = fx_signal(S["det"]), fx_signal(S["kt8"]), fx_signal(S["t"]), fx_signal(S["t"])
@@ -109,7 +113,7 @@ def cornerness_stereo(clk, rst, sink, source, k_left, k_right, *, share: int = 1
             t3.next = t2
             ktt.next = kt8 * t3
             det4.next = det
-            cr.next = det4 - (ktt << 2)
+            cr.next = det4 - (ktt_s << 2)
             source.data.next = cout[nb:]
 
         insts.append(pipeline)
@@ -159,7 +163,7 @@ def cornerness_stereo(clk, rst, sink, source, k_left, k_right, *, share: int = 1
 
         @always(clk.posedge)
         def finish():
-            cr.next = det - (ktt << 2)
+            cr.next = det - (ktt_s << 2)
             source.data.next = cout[nb:]
 
         insts += [phases, choose_operands, multiply, products, difference, finish]

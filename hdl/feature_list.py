@@ -105,7 +105,7 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
     yl = Signal(intbv(0, min=0, max=height))
     token = Signal(bool(0))
     last = Signal(bool(0))  # the right camera's beat of the frame's last pixel
-    event = Signal(bool(0))
+    hit = Signal(bool(0))  # a listed feature on this beat (not "event": a Verilog keyword)
     x_lo, x_hi, y_lo, y_hi = border, width - border, border, height - border
 
     @always_comb
@@ -115,7 +115,7 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
         yl.next = y_last[by]
         token.next = sink.valid and sink.eof and not sink.eol
         last.next = sink.valid and sink.eof and sink.eol and sink.cam
-        event.next = sink.valid and not (sink.eof and not sink.eol) and sink.data[0] and x >= x_lo and x < x_hi \
+        hit.next = sink.valid and not (sink.eof and not sink.eol) and sink.data[0] and x >= x_lo and x < x_hi \
             and y >= y_lo and y < y_hi
 
     @always_seq(clk.posedge, reset=rst)
@@ -193,7 +193,7 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
 
     @always(clk.posedge)
     def cwrite():
-        if event:
+        if hit:
             cmem[waddr].next = cur + 1
 
     # FIFO of entries kind (2 bits) | 32-bit payload.
@@ -214,11 +214,11 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
 
     @always_comb
     def entry():
-        accept.next = event and listed < max_features and fcount < depth - 2
+        accept.next = hit and listed < max_features and fcount < depth - 2
         fx.next = x
         fy.next = y
         tcount.next = listed
-        push.next = (event and listed < max_features and fcount < depth - 2) or last or token
+        push.next = (hit and listed < max_features and fcount < depth - 2) or last or token
         if token:
             din.next = concat(k_token, zero32)
         elif last:
@@ -253,7 +253,7 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
                 fresh0.next = 0
             else:
                 fresh1.next = 0
-        elif event:
+        elif hit:
             if bank:
                 fresh1.next[cidx] = 1
             else:
