@@ -43,7 +43,8 @@ def frontend_sequencer(clk, rst, mode, continuous, start, stop, ctl, rect_start,
     Parameters: none.
 
     Latency: the rectifier starts one clock after the pair is held; the pair is released one clock
-    after the rectifier's ``busy`` falls (its last fetch has been answered by then).
+    after the rectifier's ``busy`` falls (its last fetch has been answered by then); the next pair is
+    looked for once ``cam_held`` of the released one has fallen.
 
     Resources: a state register, two 32-bit counters and a 32-bit clock counter, a 16-bit counter.
     """
@@ -58,7 +59,7 @@ def frontend_sequencer(clk, rst, mode, continuous, start, stop, ctl, rect_start,
     check_signal("frame_clocks", frame_clocks, width=32)
     check_signal("list_overflows", list_overflows, width=16)
 
-    st_t = enum("IDLE", "ARM", "PAIR", "RSTART", "RFIRST", "RECT", "LISTS", "DRAIN")
+    st_t = enum("IDLE", "ARM", "PAIR", "RSTART", "RFIRST", "RECT", "REL", "LISTS", "DRAIN")
     st = Signal(st_t.IDLE)
     md = Signal(bool(0))
     more = Signal(bool(0))       # continue after this frame (continuous and no stop yet)
@@ -110,7 +111,7 @@ def frontend_sequencer(clk, rst, mode, continuous, start, stop, ctl, rect_start,
                 ctl.cam_release.next = 1
                 if md:
                     if more and not stop:
-                        st.next = st_t.PAIR
+                        st.next = st_t.REL
                     else:
                         ctl.cam_run.next = 0
                         ctl.cam_want.next = 0
@@ -118,6 +119,10 @@ def frontend_sequencer(clk, rst, mode, continuous, start, stop, ctl, rect_start,
                 else:
                     ctl.cam_want.next = 0
                     st.next = st_t.LISTS
+        elif st == st_t.REL:
+            # the released pair's cam_held falls a clock later: do not take it for the next one
+            if not ctl.cam_held:
+                st.next = st_t.PAIR
         elif st == st_t.LISTS:
             if done_now:
                 if more and not stop:

@@ -14,21 +14,26 @@ from eyestereo.tools.models import stereo_frontend as model
 
 pytestmark = pytest.mark.sim
 
-SPEC = "rig:48x32"
+SPEC = "rig:32x24"
+W, H = 32, 24
+FRAMES = {"sequential": 2, "overlapped": 3}
+TIMING = dict(h_blank=8, v_sync=1, v_back=1, v_front=1)
 
 
 @pytest.mark.parametrize("mode", ["sequential", "overlapped"])
 def test_stereo_frontend(request, mode):
     rep = run_bench("stereo_frontend", "tb_stereo_frontend",
-                    dict(mode=mode, frames=3, images="shift:3", pause=0.1 if mode == "sequential" else 0.0),
+                    dict(mode=mode, frames=FRAMES[mode], images="shift:3", timing=TIMING,
+                         pause=0.1 if mode == "sequential" else 0.0),
                     name=request.node.name, params=dict(quantizers=SPEC, feature_words=256, max_features=127))
-    assert rep["bit_exact"] and len(rep["frames"]) == 3
+    n = FRAMES[mode]
+    assert rep["bit_exact"] and len(rep["frames"]) == n
     # the captured pairs move on, frame after frame
     pairs = [tuple(f["rect_pair"]) for f in rep["frames"]]
-    assert pairs == sorted(pairs) and len(set(pairs)) == 3
-    assert rep["frames_done"] >= 3
+    assert pairs == sorted(pairs) and len(set(pairs)) == n
+    assert rep["frames_done"] >= n
     moved = {w: rep["arb"][w] for w in rep["arb"] if w.startswith("moved_")}
-    assert moved["moved_rect"] >= 3 * 48 * 32 and moved["moved_fetch"] > 0 and moved["moved_feat"] > 0
+    assert moved["moved_rect"] >= n * W * H and moved["moved_fetch"] > 0 and moved["moved_feat"] > 0
 
 
 def test_model_is_the_chain():
@@ -38,7 +43,7 @@ def test_model_is_the_chain():
     from eyestereo.tools.models import harris_stereo, rectifier
 
     cal = calibration_param(SPEC, None, None)
-    lw, rw = camera_frame("random:1", 48, 32), camera_frame("random:2", 48, 32)
+    lw, rw = camera_frame("random:1", W, H), camera_frame("random:2", W, H)
     m = model.stereo_frontend(cal, lw, rw, 10, [64] * 16)
     rl, rr = rectifier.rectifier(cal, (lw & 0xFF).astype(np.uint8), (rw & 0xFF).astype(np.uint8))
     assert np.array_equal(m["rectified"][0], rl) and np.array_equal(m["rectified"][1], rr)
