@@ -43,7 +43,7 @@ def stereo_frames(spec: str, n: int, width: int, height: int) -> list[tuple[np.n
     """``n`` stereo pairs of camera words: ``random:S`` (independent random frames) or ``shift:S`` (one
     random scene, the right camera's view shifted by a disparity, the scene moving a pixel per frame)."""
     kind, _, arg = spec.partition(":")
-    seed = int(arg or 1)
+    seed = int(arg or 1) if kind != "files" else 0
     out = []
     for i in range(n):
         if kind == "random":
@@ -52,6 +52,18 @@ def stereo_frames(spec: str, n: int, width: int, height: int) -> list[tuple[np.n
         elif kind == "shift":
             big = camera_frame(f"random:{seed}", width + 2 * n + 8, height)
             out.append((big[:, i + 8:i + 8 + width].copy(), big[:, i + 4:i + 4 + width].copy()))
+        elif kind == "files":  # a stereo pair of image files, resized to the camera size, every frame
+            import cv2
+
+            from eyestereo.tools.camera import yuv_frame
+
+            pair = []
+            for f in arg.split(","):
+                img = cv2.imread(f, cv2.IMREAD_GRAYSCALE)
+                if img is None:
+                    raise ValueError(f"cannot read image {f}")
+                pair.append(yuv_frame(cv2.resize(img, (width, height), interpolation=cv2.INTER_AREA)))
+            out.append(tuple(pair))
         else:
             raise ValueError(f"unknown stereo frame spec {spec!r}")
     return out
@@ -168,6 +180,7 @@ async def frames_bit_exact(dut):
                   lambda m: (int(np.sum(m["rect_words"] != rect)), np.argwhere(m["rect_words"] != rect)[:4].tolist()))
         pl = find(lambda m: m["list_words"] == lw, last_list)
         lst = parse_words([(d, False, False) for d in lw[:-1]] + [(lw[-1], True, True)])[0]
+        last = dict(rect=rect.tolist(), features=[list(f) for f in lst["features"]])
         results.append(dict(frame=n, rect_pair=pr, list_pair=pl, features=len(lst["features"]),
                             start_ns=t0, frame_ns=t_frame, read_ns=t_read))
         last_rect, last_list = pr, pl
@@ -196,4 +209,4 @@ async def frames_bit_exact(dut):
     write_report(cfg, dict(mode=mode, width=w, height=h, threshold=thr, frames=results, bit_exact=True,
                            frame_clocks=st["frame_clocks"], frames_done=st["frames"], arb=arb,
                            arb_words=list(ARB_WORDS), total_ns=get_sim_time(unit="ns") - t_start,
-                           camera_frame_pclk=timing.frame_pclk, axi=bus.checker.counts))
+                           camera_frame_pclk=timing.frame_pclk, axi=bus.checker.counts, last=last))
