@@ -128,12 +128,20 @@ async def frames_bit_exact(dut):
         await cocotb.start(cam.start_clock())
         cocotb.start_soon(cam.play(frame_schedule([f[idx] for f in frames], timing)))
 
-    expected = {}  # (i, j) -> model outputs, computed on demand
+    expected = {}  # (i, j, thresholds) -> model outputs, computed on demand
+    cur = ([thr] * 16, [thr] * 16)  # the thresholds the system runs with
+    adaptive = cfg.get("adaptive")  # target features per block: the host closes the loop (thesis 7.2)
+    if adaptive is not None:
+        from eyestereo.tools.matching.adaptive import SecantController
+
+        ctrls = [SecantController(adaptive, init=thr) for _ in range(2)]
 
     def model_of(i, j):
-        if (i, j) not in expected:
-            expected[(i, j)] = model.stereo_frontend(cal, frames[i][0], frames[j][1], k, [thr] * 16, nms=nms)
-        return expected[(i, j)]
+        key = (i, j, tuple(cur[0]), tuple(cur[1]))
+        if key not in expected:
+            expected[key] = model.stereo_frontend(cal, frames[i][0], frames[j][1], k, (list(cur[0]), list(cur[1])),
+                                                  nms=nms)
+        return expected[key]
 
     def find(pred, last, diff=None):
         hits = [(i, j) for i in range(n_cam) for j in range(max(0, i - 1), min(n_cam, i + 2)) if pred(model_of(i, j))]
@@ -191,6 +199,10 @@ async def frames_bit_exact(dut):
             return [int(x) for x in c[0]] == counts[0] and [int(x) for x in c[1]] == counts[1] and \
                 int(m["list"]["totals"][0]) == tot & 0xFFFF and int(m["list"]["totals"][1]) == tot >> 16
         find(counts_ok, (-1, -1))
+        results[-1].update(totals=[tot & 0xFFFF, tot >> 16], thresholds=[list(map(int, c)) for c in cur])
+        if adaptive is not None:  # the next frame's thresholds from this frame's block counts
+            cur = tuple([int(v) for v in c.update(np.array(cnt))] for c, cnt in zip(ctrls, counts))
+            await drv.configure(mode=mode, thresholds_left=cur[0], thresholds_right=cur[1])
     if mode == "overlapped":
         await drv.stop()
     for _ in range(1000):
