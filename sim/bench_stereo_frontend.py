@@ -136,8 +136,12 @@ def main(argv=None) -> int:
     args.json.parent.mkdir(parents=True, exist_ok=True)
     frames = sum(len(r["frames"]) for r in reps.values())
     args.json.write_text(json.dumps(dict(
-        fps=figs["sequential"]["fps"], fps_modes={m: f["fps"] for m, f in figs.items()}, frames=frames,
-        size=args.size, clocks=CLOCKS, simulator="GHDL (mcode), simulated time", measured=figs,
+        # fps: the 352x288 sequential figure (what the thesis estimated), derived from the measurement below
+        fps=full["sequential_fps"], fps_modes=dict(sequential=full["sequential_fps"],
+                                                   overlapped=full["overlapped_fps_bound"]),
+        fps_measured={m: f["fps"] for m, f in figs.items()}, frames=frames, size=args.size, clocks=CLOCKS,
+        simulator=f"GHDL (mcode), simulated time, measured at {args.size} and derived for 352x288 linearly in "
+                  "pixels (docs/system.md)", measured=figs,
         full_frame_derived=full), indent=2) + "\n")
     print(json.dumps(dict(fps_modes={m: f["fps"] for m, f in figs.items()}, full_frame_derived=full)))
     return 0
