@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from myhdl import Signal, always_comb, always_seq, block, concat, intbv
 
-from eyestereo.hdl.axil import AxiLite, check_axil
+from eyestereo.hdl.async_fifo import MAX_DEPTH
+from eyestereo.hdl.axil import check_axil
 from eyestereo.hdl.camera_stream import check_camera
 from eyestereo.hdl.camera_interface import camera_pair
 from eyestereo.hdl.common.checks import block_error, check_choice, check_clock, check_int, check_reset
@@ -25,7 +26,9 @@ from eyestereo.hdl.stream_cdc import stream_cdc
 from eyestereo.hdl.word_cdc import word_cdc
 from eyestereo.tools.models import poly_unit as unit_model
 from eyestereo.tools.models.sram_arbiter import CAMERA_WORD
+from eyestereo.tools.camera import ORDERS
 from eyestereo.tools.regmap import REGMAP
+from eyestereo.tools.sram import KINDS
 
 __all__ = ["stereo_frontend", "BLOCKS", "THR_BITS"]
 
@@ -110,6 +113,16 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     if feature_words < 2 * max_features + 2:
         raise block_error(f"parameter feature_words={feature_words}: a list of {max_features} features and its "
                           f"trailer need {2 * max_features + 2} words")
+
+    cam_depth = check_int("cam_depth", cam_depth, 4, MAX_DEPTH)
+    if cam_depth & (cam_depth - 1):
+        raise block_error(f"parameter cam_depth={cam_depth} must be a power of two (the camera FIFOs)")
+    kind = check_choice("kind", kind, KINDS)
+    read_latency = check_int("read_latency", read_latency, 1, 3)
+    order = check_choice("order", order, ORDERS)
+    rect_depth = check_int("rect_depth", rect_depth, 1, 16)
+    if frac is not None:
+        frac = check_int("frac", frac, 0, unit_model.MAX_FRAC)
 
     insts = []
     # ---- cameras into the memory clock ---------------------------------------------------------
