@@ -69,11 +69,54 @@ def _picture(rect: np.ndarray, features, path: Path) -> None:
     cv2.imwrite(str(path), img)
 
 
-def cmd_sim_system(args) -> int:
+def main_system(left: Path, right: Path, output: Path, *, size=(48, 32), frames: int = 2,
+                modes=("sequential", "overlapped")) -> dict:
+    """Run the system (see the module doc) and write OUTPUT/; returns the summary. Raises AssertionError
+    when the simulation fails."""
     from eyestereo.sim.bench_stereo_frontend import figures
     from eyestereo.sim.runner import run_bench
     from eyestereo.tools.camera import CameraTiming
 
+    w, h = size
+    timing = dict(h_blank=64, v_sync=1, v_back=1, v_front=1)
+    tmp = Path(tempfile.mkdtemp(prefix=".system.", dir=Path(output).parent))
+    try:
+        def one(mode):
+            return run_bench("stereo_frontend", "tb_stereo_frontend",
+                             dict(mode=mode, frames=frames, images=f"files:{Path(left).resolve()},{Path(right).resolve()}",
+                                  timing=timing),
+                             name=f"cli_{mode}_{w}x{h}", params=dict(quantizers=f"rig:{w}x{h}", feature_words=512,
+                                                                     max_features=255),
+                             log_file=tmp / f"{mode}.log")
+
+        with ThreadPoolExecutor(2) as ex:
+            reps = dict(zip(modes, ex.map(one, modes)))
+        ct = CameraTiming(width=w, height=h, **timing)
+        figs = {m: figures(r, ct) for m, r in reps.items()}
+        last = reps[modes[-1]]["last"]
+        _picture(np.array(last["rect"], np.int64), last["features"], tmp / "rectified.png")
+        summary = dict(size=f"{w}x{h}", frames={m: len(r["frames"]) for m, r in reps.items()},
+                       fps={m: f["fps"] for m, f in figs.items()},
+                       sram_share={m: f["sram_share"] for m, f in figs.items()},
+                       sram_busy={m: f["sram_busy"] for m, f in figs.items()},
+                       features_last_frame=len(last["features"]),
+                       bit_exact=all(r["bit_exact"] for r in reps.values()),
+                       clocks={"memory": 100.0, "harris": 50.0, "camera_l": 18.0, "camera_r": 17.9})
+        (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+        for m in modes:
+            (tmp / f"{m}.log").unlink(missing_ok=True)
+            (tmp / f"{m}.build.log").unlink(missing_ok=True)
+        if Path(output).exists():
+            shutil.rmtree(output)
+        tmp.rename(output)
+        tmp = None
+        return summary
+    finally:
+        if tmp is not None:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
+def cmd_sim_system(args) -> int:
     modes = [m.strip() for m in args.modes.split(",") if m.strip()]
     bad = [m for m in modes if m not in MODES]
     if bad or not modes:
@@ -90,51 +133,18 @@ def cmd_sim_system(args) -> int:
         print(f"error: {args.output.parent}: no such folder", file=sys.stderr)
         return 1
     w, h = args.size
-    timing = dict(h_blank=64, v_sync=1, v_back=1, v_front=1)
-    tmp = Path(tempfile.mkdtemp(prefix=".system.", dir=args.output.parent))
     try:
-        def one(mode):
-            return run_bench("stereo_frontend", "tb_stereo_frontend",
-                             dict(mode=mode, frames=args.frames, images=f"files:{args.left},{args.right}",
-                                  timing=timing),
-                             name=f"cli_{mode}_{w}x{h}", params=dict(quantizers=f"rig:{w}x{h}", feature_words=512,
-                                                                     max_features=255),
-                             log_file=tmp / f"{mode}.log")
-
-        try:
-            with ThreadPoolExecutor(2) as ex:
-                reps = dict(zip(modes, ex.map(one, modes)))
-        except AssertionError as e:
-            print(f"error: the system simulation failed ({str(e).splitlines()[0][:200]})", file=sys.stderr)
-            return 1
-        ct = CameraTiming(width=w, height=h, **timing)
-        figs = {m: figures(r, ct) for m, r in reps.items()}
-        last = reps[modes[-1]]["last"]
-        _picture(np.array(last["rect"], np.int64), last["features"], tmp / "rectified.png")
-        summary = dict(size=f"{w}x{h}", frames={m: len(r["frames"]) for m, r in reps.items()},
-                       fps={m: f["fps"] for m, f in figs.items()},
-                       sram_share={m: f["sram_share"] for m, f in figs.items()},
-                       features_last_frame=len(last["features"]),
-                       bit_exact=all(r["bit_exact"] for r in reps.values()),
-                       clocks={"memory": 100.0, "harris": 50.0, "camera_l": 18.0, "camera_r": 17.9})
-        (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-        for m in modes:
-            (tmp / f"{m}.log").unlink(missing_ok=True)
-            (tmp / f"{m}.build.log").unlink(missing_ok=True)
-        if args.output.exists():
-            shutil.rmtree(args.output)
-        tmp.rename(args.output)
-        tmp = None
-        if args.json:
-            args.json.write_text(json.dumps(summary, indent=2) + "\n")
-    finally:
-        if tmp is not None:
-            shutil.rmtree(tmp, ignore_errors=True)
+        summary = main_system(args.left, args.right, args.output, size=args.size, frames=args.frames, modes=modes)
+    except AssertionError as e:
+        print(f"error: the system simulation failed ({str(e).splitlines()[0][:200]})", file=sys.stderr)
+        return 1
+    if args.json:
+        args.json.write_text(json.dumps(summary, indent=2) + "\n")
     print(f"stereo front end, {w}x{h} cameras (18 / 17.9 MHz), memory 100 MHz, Harris 50 MHz (GHDL, simulated time)")
     for m in modes:
-        f = figs[m]
-        print(f"  {m:11s} frames {summary['frames'][m]}  fps {f['fps']:8.1f}  SRAM busy {100 * f['sram_busy']:5.1f} %  "
-              + " ".join(f"{x} {100 * f['sram_share'][x]:.1f}%" for x in MASTERS))
+        sh = summary["sram_share"][m]
+        print(f"  {m:11s} frames {summary['frames'][m]}  fps {summary['fps'][m]:8.1f}  SRAM busy "
+              f"{100 * summary['sram_busy'][m]:5.1f} %  " + " ".join(f"{x} {100 * sh[x]:.1f}%" for x in MASTERS))
     print(f"  features in the last frame: {summary['features_last_frame']}; bit-exact: "
           f"{'yes' if summary['bit_exact'] else 'no'}; pictures: {args.output}/rectified.png")
     return 0

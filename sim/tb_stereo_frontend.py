@@ -131,18 +131,26 @@ async def frames_bit_exact(dut):
     # stage times: the converted top keeps the blocks' signals by name (a probe, not a port)
     events = []
 
-    async def watch(name, label):
-        sig = getattr(dut, name)
+    async def watch(sig, label):
         while True:
             await Edge(sig)
             events.append((label, int(sig.value), get_sim_time(unit="ns")))
 
-    for name, label in (("rectifier0_busy", "rect_busy"), ("frontend_sequencer0_list_done", "list_done"),
-                        ("sram_subsystem0_sram_arbiter0_ctl_cam_held", "cam_held")):
-        try:
-            cocotb.start_soon(watch(name, label))
-        except AttributeError:
-            pass
+    def probe(pattern):
+        # MyHDL numbers instances per process (rectifier0, rectifier1, ...): try the first few
+        for i in range(8):
+            for j in range(8):
+                try:
+                    return getattr(dut, pattern.format(i=i, j=j))
+                except AttributeError:
+                    pass
+        return None
+
+    for pattern, label in (("rectifier{i}_busy", "rect_busy"), ("frontend_sequencer{i}_list_done", "list_done"),
+                           ("sram_subsystem{i}_sram_arbiter{j}_ctl_cam_held", "cam_held")):
+        sig = probe(pattern)
+        if sig is not None:
+            cocotb.start_soon(watch(sig, label))
 
     expected = {}  # (i, j, thresholds) -> model outputs, computed on demand
     cur = ([thr] * 16, [thr] * 16)  # the thresholds the system runs with
