@@ -84,7 +84,54 @@ def full_frame(seq: dict, ovl: dict) -> dict:
                 overlapped_fps_bound=round(min(1e3 / cam_ms, 1e3 / read_ms), 1))
 
 
-def write_doc(path: Path, size: str, reps: dict, figs: dict, full: dict, timing: dict) -> None:
+ADAPTIVE_TARGET = 0.25  # features per block wanted: 4 per camera
+
+
+def run_adaptive(frames: int, reuse: bool) -> dict:
+    """The host's closed threshold loop (SecantController on FCOUNT, thesis 7.2) over ``frames`` frames."""
+    old = ROOT / "build" / "sim" / "stereo_frontend" / "bench_adaptive" / "report.json"
+    if reuse and old.is_file():
+        rep = json.loads(old.read_text())
+        if len(rep["frames"]) == frames:
+            return rep
+    return run_bench("stereo_frontend", "tb_stereo_frontend",
+                     dict(mode="sequential", frames=frames, images="shift:3", adaptive=ADAPTIVE_TARGET,
+                          timing=dict(h_blank=8, v_sync=1, v_back=1, v_front=1)),
+                     name="bench_adaptive", params=dict(quantizers="rig:32x24", feature_words=256, max_features=127))
+
+
+def adaptive_section(rep: dict, img: Path) -> list[str]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    tot = [f["totals"] for f in rep["frames"]]
+    target = 16 * ADAPTIVE_TARGET
+    fig, ax = plt.subplots(figsize=(5, 3), dpi=90)
+    ax.plot([t[0] for t in tot], "o-", label="left")
+    ax.plot([t[1] for t in tot], "s-", label="right")
+    ax.axhline(target, color="k", ls="--", label="target")
+    ax.set_xlabel("frame")
+    ax.set_ylabel("features (FEATURES register)")
+    ax.legend()
+    fig.tight_layout()
+    img.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(img)
+    plt.close(fig)
+    rows = [f"| {i} | {t[0]} | {t[1]} | {max(f['thresholds'][0])} | {max(f['thresholds'][1])} |"
+            for i, (t, f) in enumerate(zip(tot, rep["frames"]))]
+    return ["## Closed-loop adaptive thresholds", "",
+            "Sequential mode, 32x24 cameras, the host running the matching package's `SecantController` "
+            f"(tools/matching/adaptive.py) on the FCOUNT window: target {ADAPTIVE_TARGET} features per block "
+            f"({target:.0f} per camera); each frame's 16 + 16 thresholds written over the bus before the next "
+            "start; every frame bit-exact with the model run on the thresholds it ran with.", "",
+            f"![adaptive](img/system/{img.name})", "",
+            "| frame | features left | features right | largest threshold code left | right |",
+            "|---:|---:|---:|---:|---:|", *rows, ""]
+
+
+def write_doc(path: Path, size: str, reps: dict, figs: dict, full: dict, timing: dict, adaptive=None) -> None:
     s, o = figs["sequential"], figs["overlapped"]
     lines = ["# The complete front end: frame rate in simulated time", "",
              "Written by `python -m eyestereo.sim.bench_stereo_frontend` (sim/bench_stereo_frontend.py). GHDL "
@@ -132,6 +179,8 @@ def write_doc(path: Path, size: str, reps: dict, figs: dict, full: dict, timing:
                  < full['camera_ms'] else "the host read-out of 15 bus clocks per word is the limit; a burst "
                  "host port would lift it") + "; a full frame in the overlapped mode has not been simulated).", ""]
     lines += resources_section()
+    if adaptive is not None:
+        lines += adaptive_section(adaptive, path.parent / "img" / "system" / "adaptive.png")
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text("\n".join(lines) + "\n")
 
@@ -174,6 +223,8 @@ def main(argv=None) -> int:
     ap.add_argument("--frames", type=int, default=3)
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "system.md")
     ap.add_argument("--json", type=Path, default=ROOT / "build" / "system" / "framerate.json")
+    ap.add_argument("--adaptive-frames", type=int, default=0,
+                    help="also run the closed threshold loop (sequential, 32x24) for this many frames")
     ap.add_argument("--reuse", action="store_true", help="take the benches' reports from build/ if they are there")
     args = ap.parse_args(argv)
     timing = dict(h_blank=64, v_sync=1, v_back=1, v_front=1)
@@ -184,7 +235,8 @@ def main(argv=None) -> int:
     ct = CameraTiming(width=w, height=h, **timing)
     figs = {m: figures(r, ct) for m, r in reps.items()}
     full = full_frame(figs["sequential"], figs["overlapped"])
-    write_doc(args.out, args.size, reps, figs, full, timing)
+    adaptive = run_adaptive(args.adaptive_frames, args.reuse) if args.adaptive_frames else None
+    write_doc(args.out, args.size, reps, figs, full, timing, adaptive)
     args.json.parent.mkdir(parents=True, exist_ok=True)
     frames = sum(len(r["frames"]) for r in reps.values())
     args.json.write_text(json.dumps(dict(

