@@ -93,7 +93,8 @@ async def frames_bit_exact(dut):
     nms = cfg["params"].get("nms", 3)
     mode = cfg.get("mode", "sequential")
     n_host = cfg.get("frames", 3)
-    n_cam = cfg.get("camera_frames", 2 * n_host + 4)
+    # sequential: each frame lets a few camera frames pass (arming, read-out): enough for every one
+    n_cam = cfg.get("camera_frames", 5 * n_host + 4)
     amap = AddressMap(w, h, cfg["params"].get("feature_words", 2048))
     frames = stereo_frames(cfg.get("images", "random:1"), n_cam, w, h)
     k = k_code(0.04)
