@@ -34,6 +34,7 @@ from eyestereo.hdl.fetch_interpolate import DEFAULT_DEPTH, fetch_interpolate
 from eyestereo.hdl.line_delay import line_delay
 from eyestereo.hdl.poly_unit import CoefPort, poly_unit
 from eyestereo.hdl.rectifier import rectifier
+from eyestereo.hdl.stereo_frontend import stereo_frontend
 from eyestereo.hdl.sobel import sobel
 from eyestereo.hdl.stream_checker import stream_checker
 from eyestereo.hdl.queue import QueuePort
@@ -411,6 +412,24 @@ BLOCKS["word_cdc"] = BlockSpec(
     build=lambda p: dict(sclk=Signal(bool(0)), d=Signal(intbv(0)[p["width"]:]), dclk=Signal(bool(0)),
                          q=Signal(intbv(0)[p["width"]:])),
     clocks=(("sclk", 100.0), ("dclk", 50.0)))
+
+def _build_stereo_frontend(p):
+    from eyestereo.hdl.axil import AxiLite
+    from eyestereo.hdl.camera_bus import CameraBus
+    from eyestereo.hdl.sram_bus import SramPins
+    from eyestereo.tools.regmap import REGMAP
+
+    return dict(clk=Signal(bool(0)), rst=_rst(), hclk=Signal(bool(0)), hrst=_rst(), cam_l=CameraBus(), wrst_l=_rst(),
+                cam_r=CameraBus(), wrst_r=_rst(), bus=AxiLite(REGMAP.addr_bits), sram=SramPins())
+
+
+_FRONTEND = dict(quantizers="rig", frac=poly_model.DEFAULT_FRAC, nms=3, share=1, border=None, max_features=1023,
+                 feature_words=2048, cam_depth=1024, kind="nobl", read_latency=2)
+BLOCKS["stereo_frontend"] = BlockSpec(
+    "stereo_frontend", "the complete stereo front end: two camera buses -> SRAM -> rectifier -> stereo Harris -> "
+    "feature lists, AXI4-Lite registers, sequential and overlapped modes", stereo_frontend, dict(_FRONTEND),
+    sink_width=lambda p: 8, source_width=lambda p: 16, hw_params=tuple(_FRONTEND), build=_build_stereo_frontend,
+    clocks=(("clk", 100.0), ("hclk", 50.0), ("cam_l_pclk", 18.0), ("cam_r_pclk", 18.0)))
 
 #: Simulation-only top levels (a bench harness around a block, registered by its module in
 #: ``eyestereo.sim``): :func:`get` finds them, ``make vhdl`` / ``make synth`` do not build them.

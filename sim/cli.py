@@ -244,7 +244,7 @@ def register(sub: Any) -> None:
     """Add the simulation commands (and ``rectifier --vhdl``)."""
     if "rectifier" in sub.choices:
         _wrap_rectifier(sub.choices["rectifier"])
-    p = sub.add_parser("sim", help="run generated VHDL in GHDL on your data (rectify, harris)",
+    p = sub.add_parser("sim", help="run generated VHDL in GHDL on your data (rectify, harris, system)",
                        description="Run the generated hardware in GHDL with cocotb.")
     ss = p.add_subparsers(dest="sim_command", metavar="SIMCOMMAND", required=True, parser_class=type(p))
     r = ss.add_parser("rectify", help="rectify a stereo pair with the rectifier's VHDL in GHDL",
@@ -262,3 +262,6 @@ def register(sub: Any) -> None:
     from eyestereo.sim.cli_harris import add_harris
 
     add_harris(ss)
+    from eyestereo.sim.cli_system import add_system
+
+    add_system(ss)

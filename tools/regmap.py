@@ -198,15 +198,16 @@ REGISTERS: tuple[Register, ...] = (
              (_f("frames", 0, 32, "count, wraps", connect=_SEQ),)),
     Register("FEATURES", 0x024, "status", "features found in the last completed frame, per camera",
              (_f("features_left", 0, 16, "left camera",
-                 connect="feature_list (issue 14), left count (Harris clock), through a word_cdc"),
+                 connect="feature_list total_left (stereo_frontend runs feature_list in the memory clock)"),
               _f("features_right", 16, 16, "right camera",
-                 connect="feature_list (issue 14), right count, through a word_cdc"))),
+                 connect="feature_list total_right"))),
     Register("DROPPED", 0x028, "status", "camera frames dropped (camera_interface's counters)",
              (_f("dropped_left", 0, 16, "left camera", connect="camera_pair dropped_l (already in the memory clock)"),
               _f("dropped_right", 16, 16, "right camera", connect="camera_pair dropped_r"))),
     Register("OVERFLOWS", 0x02C, "status", "frames lost to overflows after the cameras",
              (_f("harris_overflows", 0, 16, "stereo frames cut crossing into the Harris clock",
-                 connect="stream_cdc dropped (its read clock, the Harris clock), back through a word_cdc"),
+                 connect="stream_cdc dropped: the crossing into the Harris clock (back through a word_cdc) plus the "
+                         "flags' crossing back"),
               _f("list_overflows", 16, 16, "feature lists that did not fit their SRAM buffer",
                  connect=_SEQ + " (counts the lists flagged overflowed in ARB words 20, 21)"))),
     Register("FRAME_CLOCKS", 0x030, "status", "memory clocks the last completed frame took from its start "
@@ -224,8 +225,8 @@ REGISTERS: tuple[Register, ...] = (
     Register("FCOUNT", 0x180, "window", "features per block in the last completed frame: left blocks 0..15, "
              "right blocks 16..31 (read port addr = camera << 4 | block)",
              (_f("fcount", 0, 16, "features in the block",
-                 connect="feature_list's per-block counters: a read port (address camera << 4 | block, data "
-                         "2 clocks later)"),),
+                 connect="feature_list's per-block counters (memory clock): count_addr = block << 1 | camera, "
+                         "two registers for the window's latency of 2"),),
              count=32, port="fcount", latency=2, words=tuple(f"{c}{b}" for c in ("left", "right") for b in range(16))),
     Register("ARB", 0x200, "window", "the SRAM arbiter's status words (its status port, STAT in "
              "eyestereo.tools.models.sram_arbiter): words moved and clocks waited per master, frames per buffer",

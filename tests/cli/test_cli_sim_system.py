@@ -1,0 +1,65 @@
+"""``eyestereo sim system``: the whole front end's VHDL in GHDL on a real pair, and its bad-input policy."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import cv2
+import pytest
+
+from eyestereo.tools.cli import main as cli
+
+DATA = Path(__file__).resolve().parents[1] / "data"
+
+
+def run(capfd, *argv):
+    code = cli.main([str(a) for a in argv])
+    out, err = capfd.readouterr()
+    return code, out, err
+
+
+@pytest.fixture
+def pair(tmp_path):
+    img = cv2.imread(str(DATA / "tsukuba_im3.png"), cv2.IMREAD_GRAYSCALE)
+    cv2.imwrite(str(tmp_path / "l.png"), img[100:196, 150:278])
+    cv2.imwrite(str(tmp_path / "r.png"), img[100:196, 156:284])
+    return tmp_path / "l.png", tmp_path / "r.png"
+
+
+@pytest.mark.sim
+@pytest.mark.skipif(shutil.which("ghdl") is None, reason="needs GHDL")
+def test_sim_system_runs_the_front_end(capfd, tmp_path, pair):
+    lp, rp = pair
+    out, js = tmp_path / "out", tmp_path / "fig.json"
+    code, so, se = run(capfd, "sim", "system", lp, rp, "-o", out, "--json", js, "--size", "32x24",
+                       "--frames", "1", "--modes", "overlapped")
+    assert code == 0, se
+    assert sorted(p.name for p in out.iterdir()) == ["rectified.png", "summary.json"]
+    fig = json.loads(js.read_text())
+    assert fig == json.loads((out / "summary.json").read_text())
+    assert fig["bit_exact"] is True and fig["frames"] == {"overlapped": 1} and fig["fps"]["overlapped"] > 0
+    assert set(fig["sram_share"]["overlapped"]) == {"cam0", "cam1", "fetch", "rect", "feat", "host"}
+    assert cv2.imread(str(out / "rectified.png")) is not None
+    assert "bit-exact: yes" in so
+
+
+@pytest.mark.parametrize("case", ["missing", "modes", "size", "frames", "parent"])
+def test_sim_system_bad_input(capfd, tmp_path, pair, case):
+    lp, rp = pair
+    out = tmp_path / "out"
+    argv = ["sim", "system", lp, rp, "-o", out]
+    if case == "missing":
+        argv[2] = tmp_path / "nope.png"
+    elif case == "modes":
+        argv += ["--modes", "fast"]
+    elif case == "size":
+        argv += ["--size", "7x3"]
+    elif case == "frames":
+        argv += ["--frames", "0"]
+    else:
+        argv[-1] = tmp_path / "no" / "out"
+    code, so, se = run(capfd, *argv)
+    assert code != 0 and "error" in se.lower() and len(se.strip().splitlines()) <= 2, se
+    assert not out.exists() and not (tmp_path / "no").exists()
