@@ -68,3 +68,13 @@ def test_a_broken_input_fails_the_run(tmp_path):
 def test_every_section_is_listed_once():
     keys = [k for k, _, _ in SECTIONS]
     assert len(keys) == len(set(keys)) and {"regression", "quantized", "framerate", "stereo_harris"} <= set(keys)
+
+
+def test_derived_frame_rate_is_not_called_measured(tmp_path):
+    (tmp_path / "framerate.json").write_text(json.dumps(dict(
+        fps=18.8, frames=6, size="48x32", clocks={"memory": 100}, simulator="ghdl",
+        fps_modes={"sequential": 18.8, "overlapped": 50.7})))
+    rc, text = _run(tmp_path, "--section", "framerate")
+    assert rc == 0 and "Measured:" not in text
+    assert "Derived for 352x288 from a measurement on 48x32 frames: **18.80 fps**" in text
+    assert "overlapped 50.7 fps" in text and "(0.94 x)" in text

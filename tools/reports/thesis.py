@@ -566,9 +566,16 @@ def section_framerate(ctx: Context) -> list[str]:
     except (json.JSONDecodeError, KeyError, TypeError, ValueError) as e:
         raise ValueError(f"{ctx.framerate}: not a frame-rate measurement ({e})") from None
     clocks = ", ".join(f"{k} {v} MHz" for k, v in (m.get("clocks") or {}).items())
-    return out + [f"Measured: **{fps:.2f} fps** over {m.get('frames', '?')} stereo frames in simulated time "
-                  f"({clocks or 'clocks not given'}; {m.get('simulator', 'simulator not given')}), against the "
-                  f"thesis's {THESIS_FPS} fps estimate ({fps / THESIS_FPS:.2f} x).", ""]
+    size = m.get("size", "352x288")
+    # A figure simulated on smaller frames and scaled to 352x288 is called what it is.
+    how = (f"Measured: **{fps:.2f} fps** over {m.get('frames', '?')} stereo frames" if size == "352x288" else
+           f"Derived for 352x288 from a measurement on {size} frames: **{fps:.2f} fps** (sequential; "
+           f"{m.get('frames', '?')} stereo frames simulated)")
+    modes = m.get("fps_modes") or {}
+    extra = ("; per mode: " + ", ".join(f"{k} {float(v):.1f} fps" for k, v in modes.items())) if modes else ""
+    return out + [f"{how} in simulated time ({clocks or 'clocks not given'}; "
+                  f"{m.get('simulator', 'simulator not given')}){extra}, against the thesis's {THESIS_FPS} fps "
+                  f"estimate ({fps / THESIS_FPS:.2f} x).", ""]
 
 
 # --------------------------------------------------------------------------------------------------
