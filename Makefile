@@ -87,14 +87,16 @@ verilog: setup
 	$(PY) -m eyestereo.hdl.convert --hdl verilog --out build/verilog
 
 sim: simulator
-	$(PY) -m pytest -m sim -n $(JOBS)
+	$(PY) -m pytest -m sim -n $(JOBS) --dist worksteal
 
 # The benches of every block on Icarus and Verilator (MyHDL's Verilog), small frames: not in make test.
 test-sims: setup
-	$(PY) -m pytest -m othersims -n $(JOBS)
+	$(PY) -m pytest -m othersims -n $(JOBS) --dist worksteal
 
+# --dist worksteal: a worker that runs out of tests takes queued ones from the other (with the default
+# scheduler one core sat idle for the last 7 minutes of a 2-worker run while the other ran the SRAM benches).
 test: setup
-	$(PY) -m pytest -n $(JOBS)
+	$(PY) -m pytest -n $(JOBS) --dist worksteal
 
 demo: setup
 	$(PY) -m eyestereo.sim.demo --out build/demo
