@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 
 __all__ = [
+    "Interrupted",
     "Outputs",
     "atomic_output",
     "atomic_write_bytes",
@@ -60,6 +61,54 @@ TMP_MARK = ".eyestereo-"  # in every temporary name, so a leftover is recognisab
 _TEMPS: dict[str, str] = {}
 _TEMPS_LOCK = threading.Lock()
 _TEMPS_KEPT = 512
+
+
+# Signals
+
+
+class Interrupted(BaseException):
+    """A signal (SIGINT, SIGTERM, SIGHUP) ended the command; ``signum`` says which, ``written`` whether
+    an output had already been put in place when it arrived."""
+
+    def __init__(self, signum: int, written: bool = False) -> None:
+        super().__init__(signum)
+        self.signum = signum
+        self.written = written
+
+    @property
+    def status(self) -> int:
+        return 128 + self.signum
+
+
+# Signals received and not yet acted on. A signal handler's exception is lost when the signal lands
+# in code whose exceptions Python ignores (a weakref or import-lock callback, a __del__): the run
+# would then go on and commit its outputs. Every commit therefore looks here first.
+_PENDING: list[int] = []
+_COMMITS = [0]  # outputs put in place by this process (so a late signal is reported truthfully)
+
+
+def interrupt(signum: int, frame: Any = None) -> None:
+    """Signal handler: remember ``signum`` and raise :class:`Interrupted` (see :func:`check_interrupt`)."""
+    _PENDING.append(signum)
+    raise Interrupted(signum, written=_COMMITS[0] > 0)
+
+
+def check_interrupt() -> None:
+    """Raise :class:`Interrupted` if a signal arrived whose exception was swallowed on the way."""
+    if _PENDING:
+        raise Interrupted(_PENDING[0], written=_COMMITS[0] > 0)
+
+
+def _inside_a_temporary(target: Path) -> bool:
+    with _TEMPS_LOCK:
+        temps = {os.path.abspath(k) for k in _TEMPS}
+    return any(str(p) in temps for p in Path(os.path.abspath(target)).parents)
+
+
+def clear_interrupt() -> None:
+    """Forget pending signals and commits (the command line calls it when a command starts)."""
+    _PENDING.clear()
+    _COMMITS[0] = 0
 
 
 def _umask() -> int:
@@ -142,10 +191,14 @@ def atomic_output(path: str | os.PathLike[str], suffix: str | None = None) -> It
             raise ValueError(f"writing {target} produced no data")
         _check_file_target(target)
         os.chmod(tmp, file_mode(target))
-        try:
-            os.replace(tmp, target)
-        except OSError as e:
-            raise OSError(e.errno, _os_message(e, target)) from None
+        with _signals_held():
+            check_interrupt()
+            try:
+                os.replace(tmp, target)
+            except OSError as e:
+                raise OSError(e.errno, _os_message(e, target)) from None
+            if not _inside_a_temporary(target):  # a file in a folder still being written is not an output yet
+                _COMMITS[0] += 1
     finally:
         with contextlib.suppress(FileNotFoundError):
             tmp.unlink()
@@ -276,6 +329,7 @@ back as it was. An exception in the block discards every temporary.
                 self.discard()
 
     def _commit(self) -> None:
+        check_interrupt()
         for t, tmp, kind, pred in self._items:  # everything written and still allowed?
             if kind == "file":
                 _check_file_target(t)
@@ -309,6 +363,7 @@ back as it was. An exception in the block discards every temporary.
                 if old is not None:
                     os.replace(old, t) if not old.is_dir() else os.rename(old, t)
             raise
+        _COMMITS[0] += 1
         for _, old in done:
             if old is not None:
                 _remove(old)

@@ -417,3 +417,25 @@ def test_implausible_sizes_are_refused(capfd, box):
     doc["width"] = 10 ** 9
     (box / "poly.json").write_text(json.dumps(doc))
     refused(capfd, box, 1, "width 1000000000 is implausible", "ffc", box / "poly.json", "-o", box / "q.json")
+
+
+def test_a_signal_whose_exception_was_swallowed_still_ends_the_command(capfd, tmp_path):
+    """CI saw SIGINT land in an import-lock callback, where Python drops the handler's exception: the
+    command must still end with 128 + N and write nothing."""
+    from eyestereo.tools import io as IO
+    from eyestereo.tools.cli import common
+
+    def handler(args):
+        try:
+            IO.interrupt(signal.SIGINT)
+        except IO.Interrupted:
+            pass  # what Python's "Exception ignored in ..." does
+        with IO.Outputs() as out:
+            out.file(tmp_path / "result.txt").write_text("done")
+        return 0
+
+    parser = common.Parser(prog="eyestereo")
+    parser.set_defaults(func=handler)
+    assert common.run_command(parser, []) == 130
+    assert capfd.readouterr().err == "eyestereo: error: interrupted (SIGINT); nothing was written\n"
+    assert list(tmp_path.iterdir()) == []

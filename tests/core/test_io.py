@@ -171,6 +171,41 @@ def test_the_same_target_twice_is_refused(tmp_path):
     assert names(tmp_path) == []
 
 
+def _swallowed_signal(signum):
+    """A signal whose handler's exception Python drops (as it does in a weakref or import-lock
+    callback): the handler ran, but the code goes on."""
+    try:
+        IO.interrupt(signum)
+    except IO.Interrupted:
+        pass
+
+
+def test_a_swallowed_signal_still_stops_every_commit(tmp_path):
+    IO.clear_interrupt()
+    try:
+        _swallowed_signal(2)
+        with pytest.raises(IO.Interrupted) as e:
+            with IO.Outputs() as out:
+                out.file(tmp_path / "a.txt").write_text("a")
+        assert e.value.signum == 2 and e.value.status == 130 and not e.value.written
+        with pytest.raises(IO.Interrupted):
+            IO.atomic_write_text(tmp_path / "b.txt", "b")
+        assert names(tmp_path) == []
+    finally:
+        IO.clear_interrupt()
+
+
+def test_a_signal_after_a_commit_says_an_output_was_written(tmp_path):
+    IO.clear_interrupt()
+    try:
+        IO.atomic_write_text(tmp_path / "a.txt", "a")
+        with pytest.raises(IO.Interrupted) as e:
+            IO.interrupt(15)
+        assert e.value.written and e.value.status == 143
+    finally:
+        IO.clear_interrupt()
+
+
 def test_user_text_names_the_target(tmp_path):
     out = IO.Outputs()
     tmp = out.file(tmp_path / "calib.yml")

@@ -43,7 +43,7 @@ from typing import Any, NoReturn
 
 import numpy as np
 
-from eyestereo.tools.io import user_text
+from eyestereo.tools.io import Interrupted, check_interrupt, clear_interrupt, interrupt, user_text
 
 __all__ = [
     "EXIT_ERROR",
@@ -74,18 +74,6 @@ EXIT_OK = 0
 EXIT_ERROR = 1
 EXIT_USAGE = 2
 EXIT_INTERNAL = 3
-
-
-class Interrupted(BaseException):
-    """A signal (SIGINT, SIGTERM, SIGHUP) ended the command; ``signum`` says which."""
-
-    def __init__(self, signum: int) -> None:
-        super().__init__(signum)
-        self.signum = signum
-
-    @property
-    def status(self) -> int:
-        return 128 + self.signum
 
 
 class Parser(argparse.ArgumentParser):
@@ -208,6 +196,8 @@ def error_line(exc: BaseException) -> tuple[str, int]:
     """The one-line message and exit status of an exception ending a command."""
     if isinstance(exc, Interrupted):
         name = signal.Signals(exc.signum).name
+        if exc.written:
+            return f"interrupted ({name}) after some outputs were written", exc.status
         return f"interrupted ({name}); nothing was written", exc.status
     if isinstance(exc, KeyboardInterrupt):
         return "interrupted (SIGINT); nothing was written", 128 + signal.SIGINT
@@ -258,10 +248,6 @@ def quiet_libraries() -> None:
             pass
 
 
-def _raise_interrupted(signum: int, frame: Any) -> None:
-    raise Interrupted(signum)
-
-
 def run_command(parser: argparse.ArgumentParser, argv: Sequence[str] | None) -> int:
     """Parse ``argv`` with ``parser``, run the chosen handler, return the exit status (never raises
     for bad input; see the module docstring for the codes and the one-line errors)."""
@@ -280,11 +266,14 @@ def run_command(parser: argparse.ArgumentParser, argv: Sequence[str] | None) -> 
     saved_np = np.geterr()
     try:
         quiet_libraries()
+        clear_interrupt()
         if main_thread:
             for sig in (signal.SIGTERM, getattr(signal, "SIGHUP", None), signal.SIGINT):
                 if sig is not None:
-                    old_handlers[sig] = signal.signal(sig, _raise_interrupted)
-        return int(args.func(args))
+                    old_handlers[sig] = signal.signal(sig, interrupt)
+        status = int(args.func(args))
+        check_interrupt()  # a signal whose exception was swallowed (see eyestereo.tools.io.interrupt)
+        return status
     except SystemExit as e:  # a handler's own parser-style exit
         return e.code if isinstance(e.code, int) else EXIT_ERROR
     except BaseException as e:  # noqa: BLE001 - every failure becomes one line, never a traceback
