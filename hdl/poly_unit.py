@@ -251,7 +251,11 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
     for i, where in chooser.items():
         f = q(i)
         codes = tuple(cal.codes[k][i - 1] & ((1 << f.wl) - 1) for k in range(4))
-        cbits[i] = Signal(intbv(0)[f.wl:])
+        # Starts with the table's entry 0, where every index starts: in MyHDL's Verilog the table is an
+        # ``always @(index)`` block, which (SystemVerilog semantics, Icarus -g2012) never runs while the
+        # index keeps the value of its declaration, so the output would keep its own declared value
+        # (GHDL and Verilator evaluate every combinational process once at time 0).
+        cbits[i] = Signal(intbv(codes[0])[f.wl:])
         creg[i] = fmt_signal(f)
         if i not in registered:
             insts.append(assign(cbits[i], creg[i]))  # reinterpretation only
