@@ -144,7 +144,8 @@ def run_case(case, sim_name: str, *, drivers: str = "events") -> dict:
     ppc = n / (recv[2 * n - 1] - recv[n - 1])
     return dict(name=name, block=block, sim=sim_name, drivers=drivers, ppc=float(ppc), lat_min=int(lat.min()),
                 lat_max=int(lat.max()), lead_lines=radius, lead_pixels=radius, cycles=rep["cycles"], wall=wall,
-                sim_s=rep.get("sim_seconds"), compared=rep["pixels_compared"], dump=str(dump),
+                sim_s=rep.get("sim_seconds"), cpu_s=rep.get("cpu_seconds"), compared=rep["pixels_compared"],
+                dump=str(dump),
                 load=os.getloadavg()[0])
 
 
@@ -186,8 +187,10 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
            "| block | pixels / clock | latency (clocks) | window lead | clocks simulated | pixels compared bit-exact "
            "| same clocks, pixels / clock and latency on every simulator |",
            "|---|---:|---:|---|---:|---:|---|"]
+    failed = {(r["name"], r["sim"], r.get("drivers", "events")): r["error"] for r in results if r.get("error")}
+    results = [r for r in results if not r.get("error")]
     by = {(r["name"], r.get("sim", "ghdl-mcode"), r.get("drivers", "events")): r for r in results}
-    names = list(dict.fromkeys(r["name"] for r in results))
+    names = list(dict.fromkeys([r["name"] for r in results] + [k[0] for k in failed]))
     for nm in names:
         r = next((by[k] for k in by if k[0] == nm and k[2] == "events"), None)
         if r is None:
@@ -212,7 +215,10 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
             "## Simulation speed per simulator (clocks per second; same stimulus, same run, same machine)", "",
             "GHDL runs the VHDL (mcode and LLVM back ends), Icarus and Verilator MyHDL's Verilog conversion. "
             "Each cell: simulation only (cocotb's time of the test: stimulus, models and checks included) / "
-            "whole run (conversion, simulator build, start-up included). "
+            "whole run (conversion, simulator build, start-up included) / per CPU second of the simulator "
+            "process during the test (simulator and Python share the process; this rate depends least on the "
+            "load of the shared machine). 'fastest vs before' compares simulation-only rates, and in "
+            "parentheses the CPU-time rates. "
             f"'{BEFORE}': the same bench with the stream drivers of before this change (Python on every "
             "clock: source, sink sample, timeout loop). 'equal': the output words of every simulator are the "
             "same on every pixel of both frames (not only where the model specifies them).", ""]
@@ -221,24 +227,36 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
     head = ([BEFORE] if has_before else []) + cols
     out += ["| bench | " + " | ".join(head) + " | fastest vs before | equal |",
             "|---|" + "---:|" * len(head) + "---:|---|"]
+    fails: list[tuple[str, str, str]] = []
     for nm in names:
         cells = []
         before = by.get((nm, "ghdl-mcode", "clocked"))
         if has_before:
-            cells.append(f"{_rate(before['cycles'], before['sim_s'])} / {_rate(before['cycles'], before['wall'])}"
-                         if before else "-")
-        best = 0.0
+            cells.append(f"{_rate(before['cycles'], before['sim_s'])} / {_rate(before['cycles'], before['wall'])} / "
+                         f"{_rate(before['cycles'], before.get('cpu_s'))}" if before else "-")
+        best = best_cpu = 0.0
         for c in cols:
             r = by.get((nm, c, "events"))
             if r is None:
-                cells.append("-")
+                why = failed.get((nm, c, "events"))
+                if why:
+                    fails.append((nm, c, why))
+                cells.append(f"fails [{len(fails)}]" if why else "-")
                 continue
-            cells.append(f"{_rate(r['cycles'], r['sim_s'])} / {_rate(r['cycles'], r['wall'])}")
+            cells.append(f"{_rate(r['cycles'], r['sim_s'])} / {_rate(r['cycles'], r['wall'])} / "
+                         f"{_rate(r['cycles'], r.get('cpu_s'))}")
             if r["sim_s"]:
                 best = max(best, r["cycles"] / r["sim_s"])
+            if r.get("cpu_s"):
+                best_cpu = max(best_cpu, r["cycles"] / r["cpu_s"])
         gain = f"{best / (before['cycles'] / before['sim_s']):.1f}x" if (before and before["sim_s"] and best) else "-"
+        if before and before.get("cpu_s") and best_cpu:
+            gain += f" ({best_cpu / (before['cycles'] / before['cpu_s']):.1f}x)"
         eq = _equal(nm, results)
         out.append(f"| {nm} | " + " | ".join(cells) + f" | {gain} | {eq} |")
+    if fails:
+        out += ["", "Benches that did not run on a simulator, and why (the error the run stopped with):", ""]
+        out += [f"{i}. {nm} on {c}: {why}" for i, (nm, c, why) in enumerate(fails, 1)]
     out.append("")
     return "\n".join(out)
 
@@ -317,7 +335,13 @@ def main(argv=None) -> int:
         if (case[0], sim, drivers) in have or args.report_only:
             continue
         print(f"benchmark: {case[0]} on {sim}{' (per-clock drivers)' if drivers == 'clocked' else ''} ...", flush=True)
-        done.append(run_case(case, sim, drivers=drivers))
+        try:
+            done.append(run_case(case, sim, drivers=drivers))
+        except Exception as exc:  # noqa: BLE001 -- a bench that cannot run on a simulator is a result too
+            why = " ".join(str(exc).split())[:300] or type(exc).__name__
+            print(f"benchmark: {case[0]} on {sim} failed: {why}", flush=True)
+            done.append(dict(name=case[0], block=case[1], sim=sim, drivers=drivers, error=why,
+                             load=__import__("os").getloadavg()[0]))
         RESULTS.write_text(json.dumps(dict(results=done), indent=2))
     names = [c[0] for c in cases]
     results = [r for r in done if r["name"] in names and r["sim"] in sims]
