@@ -212,25 +212,43 @@ def test_async_fifo(request, data_width, depth, wmhz, rmhz, extra):
         assert rep["frames"] == [0, 2] and rep["dropped"] == 3 and rep["tokens"] == 3
 
 
-# --- the Verilog conversion on Icarus ------------------------------------------------------------------
-def test_icarus_camera_interface_overflow_and_reset(request):
+# --- the Verilog conversion on Icarus (make test) and Verilator (make test-sims) ----------------------------
+VERILOG_SIMS = ["icarus", pytest.param("verilator", marks=pytest.mark.othersims)]
+
+
+@pytest.mark.parametrize("sim", VERILOG_SIMS)
+def test_verilog_camera_interface_overflow_and_reset(request, sim):
     """The same bench on the Verilog conversion: an overflow (stall) and a read-domain reset."""
     p18, r100 = ClockSpec(ps(18), 41000), ClockSpec(ps(100), 3000)
     s0, s1 = rclk_edge(line_start(0, 2), p18, r100), rclk_edge(line_start(0, 6), p18, r100)
     k = rclk_edge(line_start(2, 3) + 10, p18, r100)
     cfg = dict(timing=BLANK, rclk=[r100.period, r100.phase], rresets=[[k, k + 4]],
                cameras=[camera(frames=FRAMES + ["random:4"], stalls=[[s0, s1]])])
-    rep = _run("camera_interface", "tb_camera_interface", cfg, request, dict(CAM, depth=16), sim="icarus")
+    rep = _run("camera_interface", "tb_camera_interface", cfg, request, dict(CAM, depth=16), sim=sim)
     s = rep["sides"][0]
     assert s["frames"] == [1, 3] and s["dropped"] == 1 and [c[0] for c in s["cut_by_rrst"]] == [2]
 
 
-def test_icarus_camera_stream_and_fifo(request):
+@pytest.mark.othersims
+@pytest.mark.parametrize("sim", ["icarus", "verilator"])
+def test_verilog_two_cameras_with_independent_clocks(request, sim):
+    """camera_pair (two pixel clocks and the system clock) on the Verilog conversion."""
+    left = camera("cam_l", mhz=17.9, phase=30011, frames=["random:1", "random:2", "random:3"])
+    right = camera("cam_r", mhz=18.3, phase=51234, frames=["random:4", "random:5", "random:6"], start=300)
+    cfg = dict(timing=BLANK, rclk=[ps(100), 7777], rresets=[], cameras=[left, right])
+    rep = _run("camera_pair", "tb_camera_interface", cfg, request, dict(CAM, depth=16), sim=sim)
+    l, r = rep["sides"]
+    assert l["frames"] == [0, 1, 2] and r["frames"] == [1, 2]  # the right one starts inside frame 0
+    assert l["dropped"] == r["dropped"] == 0
+
+
+@pytest.mark.parametrize("sim", VERILOG_SIMS)
+def test_verilog_camera_stream_and_fifo(request, sim):
     params = dict(CAM, order="VYUY", vsync_active=0, href_active=1, luma=True)
     cfg = dict(timing=BLANK, pclk=[ps(18), 30000], frames=FRAMES, faults={"1": {"line_bytes": {"2": 13}}})
-    rep = _run("camera_stream", "tb_camera_stream", cfg, request, params, sim="icarus")
+    rep = _run("camera_stream", "tb_camera_stream", cfg, request, params, sim=sim)
     assert rep["frames"] == [0, 2] and [a[0] for a in rep["aborted"]] == [1]
     cfg = dict(params=dict(data_width=16, depth=16), wclk=[ps(100), 5000], rclk=[ps(40), 1234], width=6,
                height=3, frames=5, duty=1.0, gap=20, tokens={"1": 9})
-    rep = _run("async_fifo", "tb_async_fifo", cfg, request, cfg["params"], sim="icarus")
+    rep = _run("async_fifo", "tb_async_fifo", cfg, request, cfg["params"], sim=sim)
     assert rep["frames"] == [0, 2] and rep["dropped"] == 3

@@ -18,8 +18,8 @@ pytestmark = pytest.mark.sim
 TOP = "coordinate_warper_tb"
 
 
-def _run(request, params, **cfg):
-    rep = run_bench(TOP, "tb_coordinate_warper", cfg, name=request.node.name, params=params)
+def _run(request, params, sim=None, **cfg):
+    rep = run_bench(TOP, "tb_coordinate_warper", cfg, name=request.node.name, params=params, sim=sim)
     assert rep["pairs"] == rep["frames"] * rep["width"] * rep["height"]
     return rep
 
@@ -84,3 +84,22 @@ def test_warper_netlist(request):
     rep = run_netlist_bench(TOP, "tb_coordinate_warper", dict(frames=2, seed=13, ack_p=100, ack_reg=True, en_p=220),
                             name=request.node.name, params=dict(quantizers="seed:13:2@40x20", batch=8))
     assert rep["pairs"] == 2 * 40 * 20 and rep["oor_l"] > 0
+
+
+# --- the Verilog conversion on Icarus and Verilator (make test-sims) -----------------------------------------
+@pytest.mark.othersims
+@pytest.mark.parametrize("sim", ["icarus", "verilator"])
+@pytest.mark.parametrize("case", ["random_pulse", "enable_reset", "register"])
+def test_warper_verilog(request, sim, case):
+    """The same bench and checks on MyHDL's Verilog: a random consumer, random enable with a reset and a
+    start while busy, run-time coefficients (every pair compared with the model)."""
+    if case == "random_pulse":
+        rep = _run(request, dict(quantizers="seed:4:2@40x20", batch=8, frac=8), sim=sim, frames=2, seed=4,
+                   ack_p=90, ack_reg=True)
+        assert rep["oor_l"] > 0 and rep["oor_r"] > 0
+    elif case == "enable_reset":
+        _run(request, dict(quantizers="seed:7:3@24x10", batch=4), sim=sim, frames=2, seed=60, en_p=60, ack_p=120,
+             reset_after=37, start_while_busy=True)
+    else:
+        _run(request, dict(quantizers="seed:10@24x10", batch=4, coefficients="register"), sim=sim, frames=1,
+             seed=10, ack_p=180, coefficients="random")

@@ -38,10 +38,16 @@ def test_controller_back_to_back(request, kind, seed):
                                                            write_share=0.3 if seed % 2 else 0.7))
 
 
+# The Verilog conversion: on Icarus in make test, on Verilator in make test-sims (marker othersims).
+VERILOG_SIMS = ["icarus", pytest.param("verilator", marks=pytest.mark.othersims)]
+
+
+@pytest.mark.parametrize("sim", VERILOG_SIMS)
 @pytest.mark.parametrize("kind", ["nobl", "pipelined"])
-def test_controller_icarus(request, kind):
-    """The Verilog conversion on Icarus passes the same bench."""
-    _ctrl(request, dict(kind=kind, read_latency=2), dict(seed=3, commands=200, duty=0.8), sim="icarus")
+def test_controller_verilog(request, kind, sim):
+    """The Verilog conversion passes the same bench."""
+    rep = _ctrl(request, dict(kind=kind, read_latency=2), dict(seed=3, commands=200, duty=0.8), sim=sim)
+    assert rep["sim"] == sim and rep["reads"] > 50 and rep["writes"] > 50
 
 
 def _failure_text(request, block) -> str:
@@ -113,9 +119,11 @@ def test_subsystem_reset_token_and_full_speed_fetch(request):
     assert rep["fetch_reads"] > 1500
 
 
-def test_subsystem_icarus(request):
-    """The Verilog conversion on Icarus passes the same bench."""
-    _sub(request, dict(kind="pipelined", read_latency=2), dict(seed=6, clocks=3000), sim="icarus")
+@pytest.mark.parametrize("sim", VERILOG_SIMS)
+def test_subsystem_verilog(request, sim):
+    """The Verilog conversion passes the same bench."""
+    rep = _sub(request, dict(kind="pipelined", read_latency=2), dict(seed=6, clocks=3000), sim=sim)
+    assert rep["sim"] == sim and rep["takes"]["cam"] >= 1 and rep["fetch_reads"] > 0
 
 
 def test_subsystem_bench_catches_early_release(request):
@@ -166,3 +174,12 @@ def test_subsystem_no_starvation_under_overload(request, kind):
     # the round robin is by turns (fetch and features 8 words a turn, the host 1): every one keeps moving
     assert m["fetch"] > 0.05 and m["feat"] > 0.05 and m["host"] > 0.01
     assert max(rep["host_latency"]) < 200, max(rep["host_latency"])
+
+
+@pytest.mark.othersims
+@pytest.mark.parametrize("sim", ["icarus", "verilator"])
+def test_double_buffer_verilog(request, sim):
+    """double_buffer's Verilog conversion against the same clock-true model."""
+    rep = run_sram_bench("double_buffer", "tb_double_buffer", dict(seed=2, clocks=3000, frame_rate=0.6),
+                         name=request.node.name, sim=sim)
+    assert rep["grants"] > 20 and rep["takes"] > 5 and rep["published"] > 10
