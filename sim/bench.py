@@ -97,8 +97,17 @@ class StreamTB:
         Clock(dut.clk, self.period_ns, unit="ns").start()
         # drivers="clocked": the per-clock drivers of before (make bench measures both in one run)
         self.clocked = cfg.get("drivers", "events") == "clocked"
+        # drivers="hdl": a VHDL player and recorder around the block (eyestereo.sim.hdl_drivers, GHDL)
+        self.hdl = cfg.get("drivers", "events") == "hdl"
+        idle = IdleGenerator(cfg.get("duty", 1.0), cfg.get("seed", 0))
+        if self.hdl:
+            from eyestereo.sim.hdl_drivers import HdlStreamSink, HdlStreamSource
+
+            self.source = HdlStreamSource(dut, dut.clk, idle)
+            self.sink = HdlStreamSink(dut, dut.clk, out_width, out_height)
+            return
         src, snk = (ClockedStreamSource, ClockedStreamSink) if self.clocked else (StreamSource, StreamSink)
-        self.source = src(dut, "sink", dut.clk, IdleGenerator(cfg.get("duty", 1.0), cfg.get("seed", 0)))
+        self.source = src(dut, "sink", dut.clk, idle)
         self.sink = snk(dut, "source", dut.clk, out_width, out_height)
 
     async def reset(self):
@@ -126,6 +135,10 @@ class StreamTB:
         """
         if self.clocked:
             return await self._wait_frames_clocked(n, timeout_cycles)
+        if self.hdl:
+            from eyestereo.sim.hdl_drivers import wait_frames_hdl
+
+            return await wait_frames_hdl(self, n, timeout_cycles)
         sink, source = self.sink, self.source
         deadline = get_sim_time(unit="ns") + timeout_cycles * self.period_ns
         while not (len(sink.frames) >= n and source.idle_now) and sink.error is None:

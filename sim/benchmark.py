@@ -67,8 +67,12 @@ CASES = [
 
 
 #: simulator columns: name -> (SIM, GHDL_BACKEND)
-SIMULATORS = {"ghdl-mcode": ("ghdl", "mcode"), "ghdl-llvm": ("ghdl", "llvm"), "icarus": ("icarus", None),
+SIMULATORS = {"ghdl-mcode": ("ghdl", "mcode"), "ghdl-llvm": ("ghdl", "llvm"),
+              "ghdl-llvm-hdl": ("ghdl", "llvm"), "icarus": ("icarus", None),
               "verilator": ("verilator", None)}
+#: columns whose benches run with other stream drivers than the event-driven Python ones
+DRIVERS = {"ghdl-llvm-hdl": "hdl"}
+LABELS = {"ghdl-llvm-hdl": "ghdl-llvm, HDL drivers"}
 BEFORE = "ghdl-mcode, per-clock drivers"
 RESULTS = BUILD.parent / "bench_sims.json"
 
@@ -115,7 +119,7 @@ def run_case(case, sim_name: str, *, drivers: str = "events") -> dict:
     name, block, bench, params, radius, frames = case[:6]
     extra = case[6] if len(case) > 6 else {}
     sim, backend = SIMULATORS[sim_name]
-    run_name = f"bench_{slug(name)}" + ("_clocked" if drivers == "clocked" else "")
+    run_name = f"bench_{slug(name)}" + ("" if drivers == "events" else f"_{drivers}")
     saved = os.environ.get("GHDL_BACKEND")
     if backend:
         os.environ["GHDL_BACKEND"] = backend
@@ -192,13 +196,13 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
     by = {(r["name"], r.get("sim", "ghdl-mcode"), r.get("drivers", "events")): r for r in results}
     names = list(dict.fromkeys([r["name"] for r in results] + [k[0] for k in failed]))
     for nm in names:
-        r = next((by[k] for k in by if k[0] == nm and k[2] == "events"), None)
+        r = next((by[k] for k in by if k[0] == nm and k[2] != "clocked"), None)
         if r is None:
             continue
         lat = str(r["lat_min"]) if r["lat_min"] == r["lat_max"] else f"{r['lat_min']}..{r['lat_max']}"
         n = r["lead_lines"]
         lead = f"{n} line{'s' if n > 1 else ''} + {n} px" if n else "-"
-        others = [o for k, o in by.items() if k[0] == nm and k[2] == "events"]
+        others = [o for k, o in by.items() if k[0] == nm and k[2] != "clocked"]
         same = all((o["ppc"], o["lat_min"], o["lat_max"], o["cycles"]) == (r["ppc"], r["lat_min"], r["lat_max"],
                                                                           r["cycles"]) for o in others)
         agree = f"yes ({len(others)})" if same and len(others) > 1 else ("-" if same else "**no**")
@@ -220,11 +224,14 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
             "load of the shared machine). 'fastest vs before' compares simulation-only rates, and in "
             "parentheses the CPU-time rates. "
             f"'{BEFORE}': the same bench with the stream drivers of before this change (Python on every "
-            "clock: source, sink sample, timeout loop). 'equal': the output words of every simulator are the "
+            "clock: source, sink sample, timeout loop). 'ghdl-llvm, HDL drivers': GHDL's LLVM back end with "
+            "the stream driven and recorded by VHDL processes around the block (`sim/hdl_drivers.py`: the "
+            "same idle cycles, the same checks on every recorded beat; Python wakes once per output frame). "
+            "'equal': the output words of every simulator are the "
             "same on every pixel of both frames (not only where the model specifies them).", ""]
     cols = list(sims)
     has_before = any(k[2] == "clocked" for k in by)
-    head = ([BEFORE] if has_before else []) + cols
+    head = ([BEFORE] if has_before else []) + [LABELS.get(c, c) for c in cols]
     out += ["| bench | " + " | ".join(head) + " | fastest vs before | equal |",
             "|---|" + "---:|" * len(head) + "---:|---|"]
     fails: list[tuple[str, str, str]] = []
@@ -236,9 +243,9 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
                          f"{_rate(before['cycles'], before.get('cpu_s'))}" if before else "-")
         best = best_cpu = 0.0
         for c in cols:
-            r = by.get((nm, c, "events"))
+            r = by.get((nm, c, DRIVERS.get(c, "events")))
             if r is None:
-                why = failed.get((nm, c, "events"))
+                why = failed.get((nm, c, DRIVERS.get(c, "events")))
                 if why:
                     fails.append((nm, c, why))
                 cells.append(f"fails [{len(fails)}]" if why else "-")
@@ -274,7 +281,7 @@ def _load_note(results: list[dict]) -> str:
 
 def _equal(name: str, results: list[dict]) -> str:
     """'yes (N sims)' when every simulator's dumped output words of the bench are identical."""
-    dumps = [(r["sim"], r["dump"]) for r in results if r["name"] == name and r.get("drivers", "events") == "events"
+    dumps = [(r["sim"], r["dump"]) for r in results if r["name"] == name and r.get("drivers", "events") != "clocked"
              and r.get("dump") and Path(r["dump"]).exists()]
     if len(dumps) < 2:
         return "-"
@@ -321,7 +328,7 @@ def main(argv=None) -> int:
     keep = args.resume or args.report_only
     done = json.loads(RESULTS.read_text())["results"] if (keep and RESULTS.exists()) else []
     have = {(r["name"], r["sim"], r["drivers"]) for r in done}
-    todo = [(c, s, "events") for c in cases for s in sims]
+    todo = [(c, s, DRIVERS.get(s, "events")) for c in cases for s in sims]
     if args.before and "ghdl-mcode" in sims:
         todo += [(c, "ghdl-mcode", "clocked") for c in cases if args.before == "all" or args.before in c[0]]
     # The before/after comparison first: it is the one that needs every simulator of one bench.

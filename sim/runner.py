@@ -155,14 +155,26 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
            "PYTHONPATH": os.pathsep.join([str(SIM_DIR), os.environ.get("PYTHONPATH", "")])}
     logs = {} if log_file is None else dict(log_file=str(Path(log_file).with_suffix(".build.log")))
     test_log = {} if log_file is None else dict(log_file=str(log_file))
+    hdl_drivers = config.get("drivers") == "hdl"
+    if hdl_drivers and sim != "ghdl":
+        raise ValueError(f"drivers='hdl' (the VHDL player and recorder) runs on GHDL only, not on {sim}")
     with _tool_env(sim, backend):
         if sim == "ghdl":
             sources = convert(block, build_dir, **params)
+            top = block
+            if hdl_drivers:
+                from eyestereo.sim.hdl_drivers import write_wrapper
+
+                wrapper, bits = write_wrapper(sources[-1], block, build_dir)
+                sources.append(wrapper)
+                top = wrapper.stem
+                full["hdl_in_bits"] = bits
+                env["EYESTEREO_TB"] = json.dumps(full)
             runner = get_runner("ghdl")
             opt = GHDL_LLVM_ARGS if os.environ["GHDL_BACKEND"] == "llvm" else []
-            runner.build(sources=[str(s) for s in sources], hdl_toplevel=block, build_dir=build_dir,
+            runner.build(sources=[str(s) for s in sources], hdl_toplevel=top, build_dir=build_dir,
                          build_args=GHDL_ARGS + opt, always=True, waves=waves, **logs)
-            results = runner.test(hdl_toplevel=block, hdl_toplevel_lang="vhdl",
+            results = runner.test(hdl_toplevel=top, hdl_toplevel_lang="vhdl",
                                   test_module=f"eyestereo.sim.{bench}", build_dir=build_dir, test_dir=build_dir,
                                   test_args=GHDL_ARGS, extra_env=env, plusargs=GHDL_RUN_OPTIONS, waves=waves,
                                   **test_log)

@@ -173,3 +173,30 @@ def test_small_benches_on_verilog(request, sim, case):
     block, bench, params, stim = SMALL[case]
     rep = run_bench(block, bench, stim, name=request.node.name, params=params, sim=sim)
     assert rep["frames"] == len(stim["frames"]) and rep["pixels_compared"] > 0
+
+
+# --- the VHDL player and recorder (drivers="hdl", sim/hdl_drivers.py) ---------------------------------------
+@pytest.mark.sim
+def test_hdl_drivers_same_beats_as_python_drivers(tmp_path):
+    """The same bench with the stream driven and recorded by VHDL processes: every beat sent and received
+    in the same cycle as with the Python drivers (idle cycles and a reset token included), the same words."""
+    params = dict(width=23, height=11)
+    stim = dict(frames=["random:1", "random:11"], duty=0.5, seed=1, token_after=50, timing=True)
+    reps, words = {}, {}
+    for drv in ("events", "hdl"):
+        dump = tmp_path / f"{drv}.npy"
+        reps[drv] = run_bench("sobel", "tb_sobel", dict(stim, drivers=drv, dump=str(dump)),
+                              name=f"test_hdl_drivers_{drv}", params=params, sim="ghdl", backend="mcode")
+        words[drv] = np.load(dump)
+    ev, hd = reps["events"], reps["hdl"]
+    assert hd["pixels_compared"] == ev["pixels_compared"] > 0
+    assert len(hd["sent_cycles"]) == len(ev["sent_cycles"]) == 2 * 23 * 11 + 50 + 1  # frames, cut frame, token
+    assert hd["sent_cycles"] == ev["sent_cycles"]  # the same idle cycles
+    assert hd["received_cycles"] == ev["received_cycles"] and hd["cycles"] == ev["cycles"]
+    assert (words["hdl"] == words["events"]).all()
+
+
+def test_hdl_drivers_ghdl_only():
+    with pytest.raises(ValueError, match="GHDL only"):
+        run_bench("sobel", "tb_sobel", dict(drivers="hdl"), name="never", params=dict(width=23, height=11),
+                  sim="icarus")
