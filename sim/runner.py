@@ -42,6 +42,12 @@ GHDL_LLVM_ARGS = ["-O2"]
 # MyHDL's Verilog: unread sub-block outputs, width truncations it writes on purpose. Verilator's lint
 # warnings are not errors here; the benches compare every output word with the model.
 VERILATOR_ARGS = ["-Wno-fatal", "-Wno-lint", "-Wno-style", "-O3"]
+# MyHDL writes Verilog-2001, and cocotb compiles with -g2012 (SystemVerilog) unless told otherwise: there a
+# declaration's initial value (``reg [1:0] s = 0;``) makes no event, so a combinational ``always @(s)`` of
+# MyHDL's never runs until ``s`` changes and its output keeps its own declared value (sram_subsystem: no
+# camera word reached the SRAM on Icarus; GHDL and Verilator evaluate every combinational block at time 0).
+# As Verilog-2005 (the later -g wins) the initial values are time-0 events and those blocks run.
+ICARUS_ARGS = ["-g2005"]
 
 
 def slug(text: str) -> str:
@@ -181,7 +187,7 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
         else:
             sources = convert(block, build_dir, hdl="Verilog", **params)
             runner = get_runner(sim)
-            kw = dict(build_args=VERILATOR_ARGS) if sim == "verilator" else {}
+            kw = dict(build_args=VERILATOR_ARGS if sim == "verilator" else ICARUS_ARGS)
             runner.build(sources=[str(s) for s in sources], hdl_toplevel=block, build_dir=build_dir,
                          always=True, waves=waves, timescale=("1ns", "1ps"), **kw, **logs)
             results = runner.test(hdl_toplevel=block, hdl_toplevel_lang="verilog",

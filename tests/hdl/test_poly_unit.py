@@ -98,9 +98,10 @@ def test_poly_unit_verilog_tables_at_time_zero(request, sim, seed):
     """The case that once differed on Icarus: inputs that use coefficient entry 0 right after reset.
 
     The tables of the later stages are read by indices that start at 0 and stay there; MyHDL's Verilog
-    reads them in ``always @(index)`` blocks, which Icarus (-g2012) never ran before the index changed,
-    so their outputs kept the value declared for the signal (seeds 213 and 752 failed at the first
-    input before the tables' outputs were declared with entry 0)."""
+    reads them in ``always @(index)`` blocks, which Icarus in -g2012 mode never ran before the index
+    changed, so their outputs kept the value declared for the signal (seeds 213 and 752 failed at the
+    first input). Two guards now: the tables' outputs are declared with entry 0, and the runner compiles
+    MyHDL's Verilog as Verilog-2005 (``runner.ICARUS_ARGS``)."""
     rep = _run(request, dict(quantizers="seed:3:3@24x10", frac=9), sim=sim, cycles=1500, seed=seed, en_p=0.7)
     assert rep["oor"] > 0
 

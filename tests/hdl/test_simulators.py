@@ -200,3 +200,34 @@ def test_hdl_drivers_ghdl_only():
     with pytest.raises(ValueError, match="GHDL only"):
         run_bench("sobel", "tb_sobel", dict(drivers="hdl"), name="never", params=dict(width=23, height=11),
                   sim="icarus")
+
+
+TIME_ZERO = """
+module t;
+  reg [1:0] s = 0;          // an internal register with a declared initial value
+  wire [1:0] i;
+  assign i = s[1:0];
+  reg [3:0] b = 0;          // the output of a combinational table, as MyHDL writes one
+  always @(i) begin: rom
+    case (i)
+      0: b = 5;
+      default: b = 7;
+    endcase
+  end
+  initial #1 $display("b=%0d", b);
+endmodule
+"""
+
+
+def test_icarus_runs_combinational_blocks_at_time_zero(tmp_path):
+    """With the runner's Icarus flags (after cocotb's -g2012) a combinational block whose inputs keep their
+    declared values still computes its output, as on GHDL and Verilator (b = 5, not its declared 0)."""
+    import subprocess
+
+    if not have_icarus:
+        pytest.skip("Icarus Verilog needed")
+    (tmp_path / "t.v").write_text(TIME_ZERO)
+    subprocess.run(["iverilog", "-g2012", *runner.ICARUS_ARGS, "-o", str(tmp_path / "t"), str(tmp_path / "t.v")],
+                   check=True)
+    out = subprocess.run(["vvp", str(tmp_path / "t")], capture_output=True, text=True, check=True).stdout
+    assert "b=5" in out, out
