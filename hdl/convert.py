@@ -42,12 +42,14 @@ def vhdl93_literals(text: str) -> str:
     return _SIZED_LITERAL.sub(_plain_literal, text)
 
 
-def convert(name: str, path: Path, *, hdl: str = "VHDL", entity: str | None = None, **params) -> list[Path]:
+def convert(name: str, path: Path, *, hdl: str = "VHDL", entity: str | None = None, timescale: str | None = None,
+            **params) -> list[Path]:
     """Convert one block (fresh instance) into ``path``; returns the files written (package first).
 
     Every signal and memory gets its initial value (``initial_values=True``): a simulation starts
     from the state a real FPGA starts from (flip-flops and block RAM at 0 after configuration), so no
     output is ever undefined, and synthesis keeps the values as the registers' and RAMs' INIT.
+    ``timescale``: the Verilog's `` `timescale`` (MyHDL's default 1ns/10ps when None).
     """
     spec = get(name)
     path = Path(path)
@@ -57,7 +59,8 @@ def convert(name: str, path: Path, *, hdl: str = "VHDL", entity: str | None = No
     with warnings.catch_warnings():
         # Unread outputs of shared sub-blocks (e.g. a line delay's flags) are expected; keep logs readable.
         warnings.simplefilter("ignore")
-        inst.convert(hdl=hdl, name=entity, path=str(path), initial_values=True)
+        extra = dict(timescale=timescale) if (timescale and hdl.lower() == "verilog") else {}
+        inst.convert(hdl=hdl, name=entity, path=str(path), initial_values=True, **extra)
     if hdl == "VHDL":
         vhd = path / f"{entity}.vhd"
         vhd.write_text(vhdl93_literals(vhd.read_text()))

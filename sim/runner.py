@@ -185,7 +185,9 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
                                   test_args=GHDL_ARGS, extra_env=env, plusargs=GHDL_RUN_OPTIONS, waves=waves,
                                   **test_log)
         else:
-            sources = convert(block, build_dir, hdl="Verilog", **params)
+            # 1ns/1ps as the runner's timescale: as Verilog-2005 (ICARUS_ARGS) the file's own timescale
+            # sets Icarus's precision, and MyHDL's 10 ps cannot hold the camera benches' clock periods.
+            sources = convert(block, build_dir, hdl="Verilog", timescale="1ns/1ps", **params)
             runner = get_runner(sim)
             kw = dict(build_args=VERILATOR_ARGS if sim == "verilator" else ICARUS_ARGS)
             runner.build(sources=[str(s) for s in sources], hdl_toplevel=block, build_dir=build_dir,
