@@ -7,7 +7,10 @@
   bench (bit for bit against the model) and the three give the same output words on *every* pixel,
   border included (make bench does the same on full frames);
 * marker ``othersims`` (``make test-sims``, not in ``make test``): the small benches of every stream
-  block on Icarus and on Verilator.
+  block on Icarus and on Verilator (the camera, SRAM, coordinate warper and poly_unit benches have
+  theirs in their own test files);
+* the VHDL player and recorder (``drivers="hdl"``) against the Python drivers, beat for beat;
+* Icarus's flags make a combinational block run at time 0 (MyHDL's Verilog relies on it).
 """
 
 from __future__ import annotations
