@@ -51,8 +51,11 @@ def write_wrapper(vhd: Path, entity: str, out: Path) -> tuple[Path, int]:
     extra = [n for n in names if n.startswith(("sink_", "source_")) and n.split("_", 1)[1] not in STREAM]
     if extra:
         raise ValueError(f"{entity}: drivers='hdl' drives mono streams only (found {', '.join(extra)})")
-    win = _width(names["sink_data"]["type"])
-    wout = _width(names["source_data"]["type"])
+    tin, tout = names["sink_data"]["type"], names["source_data"]["type"]
+    win = _width(tin)
+    base = tin.split("(")[0].strip().lower()
+    # the data bits of a stimulus line, in sink_data's own type
+    conv = f"{base}(bits({win + 1} downto 2))" if "(" in tin else "bits(2)"
     outer = [p for p in ports if not p["name"].startswith(("sink_", "source_"))]
     decl = ";\n        ".join(f"{p['name']}: {p['dir']} {p['type']}" for p in outer)
     maps = ",\n            ".join(f"{p['name']} => {p['name']}" for p in ports)
@@ -75,9 +78,9 @@ entity {entity}_hb is
 end entity {entity}_hb;
 
 architecture player of {entity}_hb is
-    signal sink_data: unsigned({win - 1} downto 0) := (others => '0');
+    signal sink_data: {tin} := {"(others => '0')" if "(" in tin else "'0'"};
     signal sink_valid, sink_eol, sink_eof: std_logic := '0';
-    signal source_data: unsigned({wout - 1} downto 0);
+    signal source_data: {tout};
     signal source_valid, source_eol, source_eof: std_logic;
     signal eofs: unsigned(31 downto 0) := (others => '0');
 begin
@@ -108,7 +111,7 @@ begin
                     wait until falling_edge(clk);
                 end loop;
             end if;
-            sink_data <= unsigned(bits({win + 1} downto 2));
+            sink_data <= {conv};
             sink_eol <= bits(1);
             sink_eof <= bits(0);
             sink_valid <= '1';
