@@ -99,6 +99,16 @@ NOTES = """
   image; harris_mono's Verilog flagged 293 corners where the VHDL flags 33 on a frame of rendered
   polygons, as issue 9 reported). `make verilog` now refuses operands of mixed signedness
   (`eyestereo.hdl.vlint`); the rule is in the README's "How to add a block".
+* The other difference found since: time zero. MyHDL writes a combinational block as `always @(inputs)`;
+  compiled as SystemVerilog (cocotb's `-g2012` for Icarus) a declaration's initial value makes no
+  event, so a block whose inputs keep their declared values never runs and its output keeps its own
+  declared value (GHDL and Verilator evaluate every combinational process once at the start).
+  `poly_unit`'s coefficient tables read by the later stages (indices starting at 0) gave coefficient 0
+  as 0 (test seed_3_3_24x10 failed on Icarus only), and `sram_subsystem`'s Verilog moved no camera word
+  on Icarus. Reproducer: `reg [1:0] s = 0; wire [1:0] i = s; reg [3:0] b = 0; always @(i) case (i) 0: b = 5;
+  default: b = 7; endcase` gives b = 0 on `iverilog -g2012`, 5 on `-g2005`, GHDL and Verilator
+  (`tests/hdl/test_simulators.py`). Fixed twice: the runner compiles MyHDL's Verilog as Verilog-2005, the
+  language it is written in, and the tables' outputs are declared with entry 0.
 """
 
 
