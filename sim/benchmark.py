@@ -77,6 +77,10 @@ BEFORE = "ghdl-mcode, per-clock drivers"
 RESULTS = BUILD.parent / "bench_sims.json"
 
 NOTES = """
+* Issue 9 asked for the harris_mono bench 3x faster on GHDL than before; 'fastest GHDL vs before'
+  says what this run reached against the per-clock mcode bench measured next to it (about 2.3x, by
+  simulation time and by CPU time alike: LLVM with the HDL drivers). The 3x is not reached, for the
+  reason below.
 * Where GHDL's time goes (harris_mono, `perf` on this machine): in the LLVM-compiled simulation of the
   bench about 70 % of the samples are in GHDL's compiled design and IEEE libraries, about 13 % in
   Python. Of the compiled part, numeric_std does the arithmetic bit by bit in VHDL (`"*"` is a loop of
@@ -251,8 +255,8 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
     cols = list(sims)
     has_before = any(k[2] == "clocked" for k in by)
     head = ([BEFORE] if has_before else []) + [LABELS.get(c, c) for c in cols]
-    out += ["| bench | " + " | ".join(head) + " | fastest vs before | equal |",
-            "|---|" + "---:|" * len(head) + "---:|---|"]
+    out += ["| bench | " + " | ".join(head) + " | fastest GHDL vs before | fastest vs before | equal |",
+            "|---|" + "---:|" * len(head) + "---:|---:|---|"]
     fails: list[tuple[str, str, str]] = []
     for nm in names:
         cells = []
@@ -261,6 +265,7 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
             cells.append(f"{_rate(before['cycles'], before['sim_s'])} / {_rate(before['cycles'], before['wall'])} / "
                          f"{_rate(before['cycles'], before.get('cpu_s'))}" if before else "-")
         best = best_cpu = 0.0
+        ghdl = ghdl_cpu = 0.0
         for c in cols:
             r = by.get((nm, c, DRIVERS.get(c, "events")))
             if r is None:
@@ -273,11 +278,21 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
                          f"{_rate(r['cycles'], r.get('cpu_s'))}")
             if r["sim_s"]:
                 best = max(best, r["cycles"] / r["sim_s"])
+                if c.startswith("ghdl"):
+                    ghdl = max(ghdl, r["cycles"] / r["sim_s"])
             if r.get("cpu_s"):
                 best_cpu = max(best_cpu, r["cycles"] / r["cpu_s"])
-        gain = f"{best / (before['cycles'] / before['sim_s']):.1f}x" if (before and before["sim_s"] and best) else "-"
-        if before and before.get("cpu_s") and best_cpu:
-            gain += f" ({best_cpu / (before['cycles'] / before['cpu_s']):.1f}x)"
+                if c.startswith("ghdl"):
+                    ghdl_cpu = max(ghdl_cpu, r["cycles"] / r["cpu_s"])
+        def vs(rate, cpu_rate):
+            if not (before and before["sim_s"] and rate):
+                return "-"
+            text = f"{rate / (before['cycles'] / before['sim_s']):.2f}x"
+            if before.get("cpu_s") and cpu_rate:
+                text += f" ({cpu_rate / (before['cycles'] / before['cpu_s']):.2f}x)"
+            return text
+
+        gain = vs(ghdl, ghdl_cpu) + " | " + vs(best, best_cpu)
         eq = _equal(nm, results)
         out.append(f"| {nm} | " + " | ".join(cells) + f" | {gain} | {eq} |")
     if fails:
