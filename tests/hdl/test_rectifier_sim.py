@@ -61,35 +61,6 @@ def test_rectifier(request, case):
         assert rep["clocks_per_pixel"] <= 8.0 + 0.2
 
 
-def _icarus_verilog(block, bench, cfg, name, params):
-    """The bench on MyHDL's Verilog conversion of the block, in Icarus (the Verilog back end can differ
-    from the VHDL one on mixed signed/unsigned expressions)."""
-    import json
-    import os
-
-    from cocotb_tools.runner import get_results, get_runner
-
-    from eyestereo.hdl.catalog import jsonable
-    from eyestereo.hdl.convert import convert
-    from eyestereo.sim.runner import ROOT, SIM_DIR, slug
-
-    d = ROOT / "build" / "sim_verilog" / block / slug(name)
-    if d.exists():
-        import shutil
-
-        shutil.rmtree(d)
-    d.mkdir(parents=True)
-    src = convert(block, d / "v", hdl="Verilog", **params)
-    runner = get_runner("icarus")
-    runner.build(sources=[str(s) for s in src], hdl_toplevel=block, build_dir=d, always=True, timescale=("1ns", "1ps"))
-    env = {"EYESTEREO_TB": json.dumps(dict(cfg, block=block, params=jsonable(params), report=str(d / "report.json"))),
-           "PYTHONPATH": os.pathsep.join([str(SIM_DIR), os.environ.get("PYTHONPATH", "")])}
-    res = runner.test(hdl_toplevel=block, test_module=f"eyestereo.sim.{bench}", build_dir=d, test_dir=d, extra_env=env)
-    n, failed = get_results(res)
-    assert n > 0 and failed == 0, f"{failed} of {n} failed (see {d})"
-    return json.loads((d / "report.json").read_text())
-
-
 @pytest.mark.parametrize("kind", ["netlist", "verilog"])
 def test_fetch_interpolate_other_back_ends(request, kind):
     """GHDL's netlist of the VHDL (what make synth measures) and MyHDL's Verilog, both in Icarus."""
@@ -104,5 +75,7 @@ def test_fetch_interpolate_other_back_ends(request, kind):
 
         rep = run_netlist_bench("fetch_interpolate", "tb_fetch_interpolate", cfg, name=request.node.name, params=params)
     else:
-        rep = _icarus_verilog("fetch_interpolate", "tb_fetch_interpolate", cfg, request.node.name, params)
+        # the runner's Icarus run: MyHDL's Verilog compiled as Verilog-2005 (runner.ICARUS_ARGS)
+        rep = run_bench("fetch_interpolate", "tb_fetch_interpolate", cfg, name=request.node.name, params=params,
+                        sim="icarus")
     assert rep["beats"] == 2 * rep["pairs"] and len(rep["masks"]) >= 8
