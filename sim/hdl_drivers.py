@@ -214,7 +214,8 @@ class HdlStreamSource:
 
     @property
     def idle_now(self) -> bool:
-        return not self.queue or self.started and int(self.dut.hb_done.value) == 1
+        """Nothing left to hand to the player (whether it has played everything is ``hb_done``)."""
+        return not self.queue
 
     def start(self, width: int) -> None:
         """Write the queued beats (idle cycles drawn now, one draw per cycle) and start the player."""
