@@ -96,7 +96,7 @@ test-sims: setup
 # --dist worksteal: a worker that runs out of tests takes queued ones from the other (with the default
 # scheduler one core sat idle for the last 7 minutes of a 2-worker run while the other ran the SRAM benches).
 test: setup
-	$(PY) -m pytest -n $(JOBS) --dist worksteal
+	$(PY) -m pytest -n $(JOBS) --dist worksteal --durations=25
 
 demo: setup
 	$(PY) -m eyestereo.sim.demo --out build/demo

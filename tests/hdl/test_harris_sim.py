@@ -6,7 +6,7 @@ and two frames back to back; see tests/test_sim.py for what the bench checks.
 
 import pytest
 
-from eyestereo.sim.runner import fastest_ghdl_backend, run_bench
+from eyestereo.sim.runner import fastest_ghdl_backend, fastest_simulator, run_bench
 from eyestereo.tools.models import harris_mono as hm
 
 pytestmark = pytest.mark.sim
@@ -20,8 +20,8 @@ DUTIES = [1.0, 0.5, 0.1]
 FULL = fastest_ghdl_backend()
 
 
-def _run(block, bench, params, stim, request, backend=None):
-    report = run_bench(block, bench, stim, name=request.node.name, params=params, backend=backend)
+def _run(block, bench, params, stim, request, backend=None, sim=None):
+    report = run_bench(block, bench, stim, name=request.node.name, params=params, backend=backend, sim=sim)
     assert report["frames"] == len(stim["frames"])
     assert report["pixels_compared"] > 0
     return report
@@ -116,16 +116,20 @@ def test_harris_mono_pattern_small(request):
 
 
 def test_harris_mono_full_frames_4x4_nms3(request):
-    """Two real 352x288 frames back to back at full rate, 4x4 blocks with 16 different thresholds."""
+    """Two real 352x288 frames back to back at full rate, 4x4 blocks with 16 different thresholds.
+
+    On the fastest simulator (Verilator when installed), as the next one: the VHDL runs full frames in
+    test_harris_mono_full_frame_nms1, and
+    tests/hdl/test_simulators.py checks GHDL, Icarus and Verilator give the same words on full frames."""
     _run("harris_mono", "tb_harris_mono", dict(width=352, height=288, blocks=(4, 4), nms=3),
          dict(frames=["file:tsukuba_im3.png", "file:chessboard_left01.jpg"], duty=1.0, k=K04,
-              thresholds=THR_TSUKUBA, token_after=3000), request, backend=FULL)
+              thresholds=THR_TSUKUBA, token_after=3000), request, sim=fastest_simulator())
 
 
 def test_harris_mono_full_frame_global_nms5_gaps(request):
     _run("harris_mono", "tb_harris_mono", dict(width=352, height=288, blocks=(1, 1), nms=5),
          dict(frames=["file:chessboard_left01.jpg"], duty=0.6, seed=5, k=hm.k_code(0.06),
-              thresholds=[hm.threshold_code(2e8)]), request, backend=FULL)
+              thresholds=[hm.threshold_code(2e8)]), request, sim=fastest_simulator())
 
 
 def test_harris_mono_full_frame_nms1(request):
@@ -135,6 +139,7 @@ def test_harris_mono_full_frame_nms1(request):
 
 
 def test_harris_mono_test_pattern_in_hardware(request):
-    """The checkerboard test pattern through the VHDL: the same flags as the model, bit for bit."""
+    """The checkerboard test pattern through the hardware: the same flags as the model, bit for bit
+    (on the fastest simulator; the VHDL's full frames: test_harris_mono_full_frame_nms1)."""
     _run("harris_mono", "tb_harris_mono", dict(width=352, height=288, blocks=(1, 1), nms=5),
-         dict(frames=["checker:1"], duty=1.0, k=hm.k_code(0.24), thresholds=[13]), request, backend=FULL)
+         dict(frames=["checker:1"], duty=1.0, k=hm.k_code(0.24), thresholds=[13]), request, sim=fastest_simulator())
