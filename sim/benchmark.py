@@ -68,11 +68,17 @@ CASES = [
 
 #: simulator columns: name -> (SIM, GHDL_BACKEND)
 SIMULATORS = {"ghdl-mcode": ("ghdl", "mcode"), "ghdl-llvm": ("ghdl", "llvm"),
-              "ghdl-llvm-hdl": ("ghdl", "llvm"), "icarus": ("icarus", None),
+              "ghdl-llvm-hdl": ("ghdl", "llvm"), "ghdl-llvm-net": ("ghdl", "llvm"),
+              "ghdl-llvm-net-hdl": ("ghdl", "llvm"), "icarus": ("icarus", None),
               "verilator": ("verilator", None)}
 #: columns whose benches run with other stream drivers than the event-driven Python ones
-DRIVERS = {"ghdl-llvm-hdl": "hdl"}
-LABELS = {"ghdl-llvm-hdl": "ghdl-llvm, HDL drivers"}
+DRIVERS = {"ghdl-llvm-hdl": "hdl", "ghdl-llvm-net-hdl": "hdl"}
+#: columns that simulate GHDL's synthesized VHDL netlist of the block instead of its VHDL (runner design=)
+DESIGNS = {"ghdl-llvm-net": "netlist", "ghdl-llvm-net-hdl": "netlist"}
+#: measured for issue 9 (see the notes), slower than the VHDL: only with --sims
+OPT_IN = ("ghdl-llvm-net", "ghdl-llvm-net-hdl")
+LABELS = {"ghdl-llvm-hdl": "ghdl-llvm, HDL drivers", "ghdl-llvm-net": "ghdl-llvm, netlist",
+          "ghdl-llvm-net-hdl": "ghdl-llvm, netlist, HDL drivers"}
 BEFORE = "ghdl-mcode, per-clock drivers"
 RESULTS = BUILD.parent / "bench_sims.json"
 
@@ -93,6 +99,18 @@ NOTES = """
   altogether (the HDL drivers column) gains only what Python cost. More would need the VHDL itself to
   do less per clock (numeric_std arithmetic on 36-bit words is most of it), which is the product and
   was left alone.
+* Also measured for the 3x (harris_mono 4x4, one run, load 2.1 to 3.5; simulation-only / CPU clocks/s):
+  per-clock mcode bench 2109 / 2198, LLVM with HDL drivers 5221 / 5291 (2.48x / 2.41x), and GHDL's own
+  synthesized netlist of the same VHDL (`ghdl synth --out=vhdl`, runner option `design="netlist"`,
+  columns `--sims ghdl-llvm-net,ghdl-llvm-net-hdl`) on LLVM: 2715 / 2736 with the Python drivers, 2904 /
+  2947 with the HDL drivers, bit-exact with the model and the VHDL on both frames, but about half the
+  VHDL's speed: the netlist turns every intermediate value into a signal (1400 signals and 800
+  concurrent assignments against 381 signals, each its own process and delta cycle) and keeps
+  numeric_std's `"*"`. Debian's LLVM IEEE libraries are already compiled with -O2 (numeric_std-body.o
+  has the text size of a -O2 build, half of -O0's; -O3 is 2 % larger); cocotb's runner passes
+  build_args to both analysis and elaboration, so `-O2` reaches the design too. GHDL 2.0 has no
+  run-time option that does less work (`--ieee-asserts=disable` is on; cocotb registers value-change
+  callbacks only for what a bench awaits, and with the HDL drivers that is a few signals per frame).
 * On Verilator the design is cheap and Python's wake-ups are most of a bench's time: the stream
   drivers wake once per beat (source and sink, at the falling edge mid-cycle) and sleep across idle
   stretches and while the output is idle.
@@ -142,7 +160,9 @@ def run_case(case, sim_name: str, *, drivers: str = "events") -> dict:
     name, block, bench, params, radius, frames = case[:6]
     extra = case[6] if len(case) > 6 else {}
     sim, backend = SIMULATORS[sim_name]
-    run_name = f"bench_{slug(name)}" + ("" if drivers == "events" else f"_{drivers}")
+    design = DESIGNS.get(sim_name, "vhdl")
+    run_name = (f"bench_{slug(name)}" + ("" if drivers == "events" else f"_{drivers}")
+                + ("" if design == "vhdl" else f"_{design}"))
     saved = os.environ.get("GHDL_BACKEND")
     if backend:
         os.environ["GHDL_BACKEND"] = backend
@@ -151,7 +171,7 @@ def run_case(case, sim_name: str, *, drivers: str = "events") -> dict:
         dump = out_dir.parent / f"{out_dir.name}.frames.npy"
         t0 = time.perf_counter()
         rep = run_bench(block, bench, dict(extra, frames=frames, duty=1.0, timing=True, drivers=drivers,
-                                           dump=str(dump)), name=run_name, params=params, sim=sim)
+                                           design=design, dump=str(dump)), name=run_name, params=params, sim=sim)
         wall = time.perf_counter() - t0
     finally:
         if saved is None:
@@ -340,8 +360,10 @@ def synth_section(doc: Path) -> str:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description="Measure throughput, latency and simulation speed on every simulator.")
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "benchmarks.md")
-    ap.add_argument("--sims", default=",".join(SIMULATORS),
-                    help=f"comma-separated simulators (default: all of {', '.join(SIMULATORS)} that are installed)")
+    default_sims = [s for s in SIMULATORS if s not in OPT_IN]
+    ap.add_argument("--sims", default=",".join(default_sims),
+                    help=f"comma-separated simulators (default: all of {', '.join(default_sims)} that are installed; "
+                         f"also {', '.join(OPT_IN)}: GHDL's synthesized VHDL netlist of the block)")
     ap.add_argument("--cases", default="", help="only the benches whose name contains one of these (comma-separated)")
     ap.add_argument("--before", default="harris_mono (4x4",
                     help="benches also run with the per-clock drivers of before ('' none, 'all' every bench)")

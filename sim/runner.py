@@ -154,6 +154,11 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
     the bench may write a JSON report to ``report.json`` in the build folder, which is returned with
     ``sim`` and ``sim_seconds`` (cocotb's time of the test itself) added. Raises AssertionError when any
     cocotb test fails or no test ran.
+
+    ``config["design"]``: ``"vhdl"`` (default) simulates the block's VHDL; ``"netlist"`` (GHDL only)
+    simulates GHDL's own synthesized VHDL netlist of it instead (:func:`ghdl_vhdl_netlist`), with either
+    kind of drivers: the same bench and model checks on the circuit synthesis sees. Measured for issue 9
+    (docs/benchmarks.md): bit-exact, but about half the VHDL's speed on GHDL.
     """
     sim = simulator(sim)
     params = dict(params or {})
@@ -169,16 +174,23 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
     logs = {} if log_file is None else dict(log_file=str(Path(log_file).with_suffix(".build.log")))
     test_log = {} if log_file is None else dict(log_file=str(log_file))
     hdl_drivers = config.get("drivers") == "hdl"
+    netlist = config.get("design", "vhdl") == "netlist"
+    if netlist and sim != "ghdl":
+        raise ValueError(f"design='netlist' (GHDL's synthesized VHDL netlist) runs on GHDL only, not on {sim}")
     if hdl_drivers and sim != "ghdl":
         raise ValueError(f"drivers='hdl' (the VHDL player and recorder) runs on GHDL only, not on {sim}")
     with _tool_env(sim, backend):
         if sim == "ghdl":
             sources = convert(block, build_dir, **params)
             top = block
+            wrapper = None
             if hdl_drivers:
                 from eyestereo.sim.hdl_drivers import write_wrapper
 
                 wrapper, bits = write_wrapper(sources[-1], block, build_dir)
+            if netlist:
+                sources[-1] = ghdl_vhdl_netlist(sources, block, build_dir)
+            if wrapper is not None:
                 sources.append(wrapper)
                 top = wrapper.stem
                 full["hdl_in_bits"] = bits
@@ -213,6 +225,28 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
     if seconds is not None:
         out.setdefault("sim_seconds", seconds)
     return out
+
+
+def ghdl_vhdl_netlist(files: list[Path], top: str, build_dir: Path) -> Path:
+    """GHDL's synthesized VHDL netlist of ``top`` (``ghdl synth --std=08 --out=vhdl``), as ``<top>_netlist.vhd``.
+
+    The same entity and ports as the VHDL (it still uses the MyHDL package), one architecture of
+    GHDL's netlist cells; written next to the VHDL in ``build_dir``.
+    """
+    from eyestereo.hdl.netlist import _ghdl_synth, lint_vhdl
+
+    lint_vhdl(files)
+    work = Path(build_dir) / "ghdl_synth"
+    work.mkdir(parents=True, exist_ok=True)
+    text = _ghdl_synth(files, top, "vhdl", "08", work)
+    # GHDL 2.0 writes a 1-bit unsigned/signed port's inner net as a std_logic scalar and converts it
+    # with a type conversion its own analyser refuses (``unresolved_unsigned(wrap_x)``): an aggregate.
+    scalars = set(re.findall(r"^\s*signal (wrap_\w+): std_logic;", text, re.M))
+    text = re.sub(r"\bunresolved_(?:un)?signed\s*\((wrap_\w+)\)",
+                  lambda m: f"(0 => {m.group(1)})" if m.group(1) in scalars else m.group(0), text)
+    path = Path(build_dir) / f"{top}_netlist.vhd"
+    path.write_text(text)
+    return path
 
 
 def sim_seconds(build_dir: Path) -> float | None:

@@ -205,6 +205,29 @@ def test_hdl_drivers_ghdl_only():
                   sim="icarus")
 
 
+# --- GHDL's synthesized VHDL netlist on GHDL (runner design="netlist") --------------------------------------
+@pytest.mark.sim
+def test_ghdl_vhdl_netlist_same_words_as_vhdl(tmp_path):
+    """harris_mono as GHDL's own synthesized VHDL netlist, on GHDL with the HDL drivers: the bench's model
+    checks pass (bit for bit) and every output word equals the VHDL's, border pixels included."""
+    params = dict(width=40, height=24, blocks=(2, 2), nms=3)
+    stim = dict(frames=["random:1", "random:5"], duty=0.7, seed=3, k=10, thresholds=[40, 10, 60, 0])
+    words = {}
+    for design, drv in (("vhdl", "events"), ("netlist", "hdl")):
+        dump = tmp_path / f"{design}.npy"
+        rep = run_bench("harris_mono", "tb_harris_mono", dict(stim, drivers=drv, design=design, dump=str(dump)),
+                        name=f"test_netlist_{design}", params=params, sim="ghdl", backend="mcode")
+        assert rep["pixels_compared"] > 0
+        words[design] = np.load(dump)
+    assert words["netlist"].shape == words["vhdl"].shape and (words["netlist"] == words["vhdl"]).all()
+
+
+def test_ghdl_vhdl_netlist_ghdl_only():
+    with pytest.raises(ValueError, match="GHDL only"):
+        run_bench("sobel", "tb_sobel", dict(design="netlist"), name="never", params=dict(width=23, height=11),
+                  sim="icarus")
+
+
 TIME_ZERO = """
 module t;
   reg [1:0] s = 0;          // an internal register with a declared initial value
