@@ -206,7 +206,7 @@ def test_hdl_drivers_ghdl_only():
 
 
 # --- GHDL's synthesized VHDL netlist on GHDL (runner design="netlist") --------------------------------------
-@pytest.mark.sim
+@pytest.mark.othersims  # a simulator variant (slower than the VHDL): make test-sims, not make test
 def test_ghdl_vhdl_netlist_same_words_as_vhdl(tmp_path):
     """harris_mono as GHDL's own synthesized VHDL netlist, on GHDL with the HDL drivers: the bench's model
     checks pass (bit for bit) and every output word equals the VHDL's, border pixels included."""
