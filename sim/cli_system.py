@@ -5,7 +5,8 @@
 models (18 and 17.9 MHz) through the whole stereo_frontend (SRAM model, rectifier, stereo Harris, feature
 lists) in both modes (``--modes``); the host driver reads every frame back over AXI4-Lite and compares it
 with the numpy chain. Writes ``OUT/rectified.png`` (the rectified pair side by side with row lines and
-the corners) and ``OUT/summary.json``; ``--json FILE`` the same figures (frames, fps per mode, SRAM share
+the corners), ``OUT/matches.png`` (the host's feature lists matched by the matching package, coloured by
+disparity) and ``OUT/summary.json``; ``--json FILE`` the same figures (frames, fps per mode, SRAM share
 per master, bit_exact). A one-screen summary on stdout. Small frames keep it to a few minutes on 2 cores
 (GHDL runs the system at a few thousand clocks per second). Errors: one line, exit status 1, nothing
 written.
@@ -69,6 +70,50 @@ def _picture(rect: np.ndarray, features, path: Path) -> None:
     cv2.imwrite(str(path), img)
 
 
+def _matches_picture(rect: np.ndarray, features, path: Path) -> dict:
+    """The matched features coloured by disparity: the host's feature lists (left and right corners of the
+    last frame it read) matched by the matching package (:func:`eyestereo.tools.matching.sparse.match_features`,
+    the defaults of ``eyestereo evaluate``: NCC 11x11 >= 0.75, left-right check, disparities 0 .. width / 4,
+    same row) on the rectified pair it read. Each match is a filled dot on the left image at the left
+    corner, a line to where its right corner lies, coloured by disparity (jet: blue near 0, red at the
+    largest); unmatched corners are grey rings. Returns the count of corners and matches and the
+    disparities' range (empty lists give no matches, not an error)."""
+    import cv2
+
+    from eyestereo.tools.matching.evaluate import DEFAULTS, default_d_max
+    from eyestereo.tools.matching.sparse import match_features
+
+    left = (rect & 0xFF).astype(np.uint8)
+    right = (rect >> 8).astype(np.uint8)
+    h, w = left.shape
+    fl = np.array([(x, y) for x, y, cam in features if cam == 0], np.int64).reshape(-1, 2)
+    fr = np.array([(x, y) for x, y, cam in features if cam == 1], np.int64).reshape(-1, 2)
+    disp = np.zeros(0, np.int64)
+    lxy = rxy = np.zeros((0, 2), np.int64)
+    if len(fl) and len(fr):
+        m = match_features(left, right, fl, fr, window=DEFAULTS["window"], cost=DEFAULTS["cost"],
+                           ncc_min=DEFAULTS["ncc_min"], lr_check=DEFAULTS["lr_check"], d_min=0,
+                           d_max=default_d_max(w), rows=DEFAULTS["rows"])
+        disp, lxy, rxy = m.disparity, m.left, m.right
+    s = max(1, 480 // w)
+    img = cv2.cvtColor(left, cv2.COLOR_GRAY2BGR)
+    img = cv2.resize(img, (w * s, h * s), interpolation=cv2.INTER_NEAREST)
+    img = (img * 0.7).astype(np.uint8)
+    d_hi = max(1, int(disp.max())) if len(disp) else 1
+    for x, y in fl:
+        cv2.circle(img, (int(x) * s + s // 2, int(y) * s + s // 2), max(3, s), (160, 160, 160), 1)
+    for (xl, yl), (xr, yr), d in zip(lxy, rxy, disp):
+        c = cv2.applyColorMap(np.array([[int(255 * d / d_hi)]], np.uint8), cv2.COLORMAP_JET)[0, 0].tolist()
+        pl = (int(xl) * s + s // 2, int(yl) * s + s // 2)
+        cv2.line(img, pl, (int(xr) * s + s // 2, int(yr) * s + s // 2), c, 1)
+        cv2.circle(img, pl, max(3, s), c, -1)
+    bar = cv2.applyColorMap(np.tile(np.linspace(0, 255, w * s).astype(np.uint8), (12, 1)), cv2.COLORMAP_JET)
+    cv2.putText(bar, f"d = 0 .. {d_hi}", (4, 10), cv2.FONT_HERSHEY_SIMPLEX, 0.35, (255, 255, 255), 1)
+    cv2.imwrite(str(path), np.vstack([img, bar]))
+    return dict(corners=[len(fl), len(fr)], matches=int(len(disp)),
+                disparity=[int(disp.min()), int(disp.max())] if len(disp) else None)
+
+
 def main_system(left: Path, right: Path, output: Path, *, size=(48, 32), frames: int = 2,
                 modes=("sequential", "overlapped")) -> dict:
     """Run the system (see the module doc) and write OUTPUT/; returns the summary. Raises AssertionError
@@ -95,11 +140,12 @@ def main_system(left: Path, right: Path, output: Path, *, size=(48, 32), frames:
         figs = {m: figures(r, ct) for m, r in reps.items()}
         last = reps[modes[-1]]["last"]
         _picture(np.array(last["rect"], np.int64), last["features"], tmp / "rectified.png")
+        matched = _matches_picture(np.array(last["rect"], np.int64), last["features"], tmp / "matches.png")
         summary = dict(size=f"{w}x{h}", frames={m: len(r["frames"]) for m, r in reps.items()},
                        fps={m: f["fps"] for m, f in figs.items()},
                        sram_share={m: f["sram_share"] for m, f in figs.items()},
                        sram_busy={m: f["sram_busy"] for m, f in figs.items()},
-                       features_last_frame=len(last["features"]),
+                       features_last_frame=len(last["features"]), matches_last_frame=matched,
                        bit_exact=all(r["bit_exact"] for r in reps.values()),
                        clocks={"memory": 100.0, "harris": 50.0, "camera_l": 18.0, "camera_r": 17.9})
         (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
@@ -145,6 +191,8 @@ def cmd_sim_system(args) -> int:
         sh = summary["sram_share"][m]
         print(f"  {m:11s} frames {summary['frames'][m]}  fps {summary['fps'][m]:8.1f}  SRAM busy "
               f"{100 * summary['sram_busy'][m]:5.1f} %  " + " ".join(f"{x} {100 * sh[x]:.1f}%" for x in MASTERS))
-    print(f"  features in the last frame: {summary['features_last_frame']}; bit-exact: "
-          f"{'yes' if summary['bit_exact'] else 'no'}; pictures: {args.output}/rectified.png")
+    mt = summary["matches_last_frame"]
+    print(f"  features in the last frame: {summary['features_last_frame']}, matched {mt['matches']} "
+          f"(disparities {mt['disparity']}); bit-exact: {'yes' if summary['bit_exact'] else 'no'}; "
+          f"pictures: {args.output}/rectified.png, matches.png")
     return 0
