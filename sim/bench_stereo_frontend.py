@@ -78,6 +78,7 @@ def run_mode(mode: str, size: str, frames: int, timing: dict, sim: str, reuse: b
         rep = json.loads(kept.read_text())
         if extra.get("speed_us") or len(rep.get("frames", [])) == frames:
             return rep
+    RUNS.mkdir(parents=True, exist_ok=True)
     t0 = time.time()
     print(f"[bench] {tag}: {frames} frame(s) on {sim_label(sim, backend)} ...", flush=True)
     full = tuple(int(v) for v in size.split("x")) == FULL
@@ -178,6 +179,7 @@ def run_adaptive(frames: int, size: str, sim: str, reuse: bool) -> dict:
         rep = json.loads(kept.read_text())
         if len(rep["frames"]) == frames:
             return rep
+    RUNS.mkdir(parents=True, exist_ok=True)
     t0 = time.time()
     print(f"[bench] {tag}: {frames} frames on {sim_label(sim)} ...", flush=True)
     # the initial thresholds leave at most 8 features per camera: the loop has to pull the count up

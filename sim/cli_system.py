@@ -51,6 +51,8 @@ def add_system(sub: Any) -> None:
     p.add_argument("--size", type=_size, default=(48, 32), help="camera size WxH (default 48x32)")
     p.add_argument("--frames", type=int, default=2, help="stereo frames the host reads per mode (default 2)")
     p.add_argument("--modes", default="sequential,overlapped", help="comma list of modes (default both)")
+    p.add_argument("--sim", choices=("ghdl", "icarus", "verilator"), default=None,
+                   help="simulator (default: the fastest here: Verilator on MyHDL's Verilog if installed, else GHDL)")
     p.set_defaults(func=cmd_sim_system)
 
 
@@ -115,14 +117,15 @@ def _matches_picture(rect: np.ndarray, features, path: Path) -> dict:
 
 
 def main_system(left: Path, right: Path, output: Path, *, size=(48, 32), frames: int = 2,
-                modes=("sequential", "overlapped")) -> dict:
+                modes=("sequential", "overlapped"), sim: str | None = None) -> dict:
     """Run the system (see the module doc) and write OUTPUT/; returns the summary. Raises AssertionError
     when the simulation fails."""
-    from eyestereo.sim.bench_stereo_frontend import figures
+    from eyestereo.sim.bench_stereo_frontend import PUBLIC, fastest_simulator, figures, sim_label
     from eyestereo.sim.runner import run_bench
     from eyestereo.tools.camera import CameraTiming
 
     w, h = size
+    sim = sim or fastest_simulator()
     timing = dict(h_blank=64, v_sync=1, v_back=1, v_front=1)
     tmp = Path(tempfile.mkdtemp(prefix=".system.", dir=Path(output).parent))
     try:
@@ -132,9 +135,10 @@ def main_system(left: Path, right: Path, output: Path, *, size=(48, 32), frames:
                                   timing=timing),
                              name=f"cli_{mode}_{w}x{h}", params=dict(quantizers=f"rig:{w}x{h}", feature_words=512,
                                                                      max_features=255),
-                             log_file=tmp / f"{mode}.log")
+                             log_file=tmp / f"{mode}.log", sim=sim, public=PUBLIC if sim == "verilator" else None)
 
-        with ThreadPoolExecutor(2) as ex:
+        # GHDL: both modes at once (2 cores); a Verilator build already uses both cores: one after the other
+        with ThreadPoolExecutor(1 if sim == "verilator" else 2) as ex:
             reps = dict(zip(modes, ex.map(one, modes)))
         ct = CameraTiming(width=w, height=h, **timing)
         figs = {m: figures(r, ct) for m, r in reps.items()}
@@ -146,7 +150,7 @@ def main_system(left: Path, right: Path, output: Path, *, size=(48, 32), frames:
                        sram_share={m: f["sram_share"] for m, f in figs.items()},
                        sram_busy={m: f["sram_busy"] for m, f in figs.items()},
                        features_last_frame=len(last["features"]), matches_last_frame=matched,
-                       bit_exact=all(r["bit_exact"] for r in reps.values()),
+                       bit_exact=all(r["bit_exact"] for r in reps.values()), simulator=sim_label(sim),
                        clocks={"memory": 100.0, "harris": 50.0, "camera_l": 18.0, "camera_r": 17.9})
         (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
         for m in modes:
@@ -180,13 +184,15 @@ def cmd_sim_system(args) -> int:
         return 1
     w, h = args.size
     try:
-        summary = main_system(args.left, args.right, args.output, size=args.size, frames=args.frames, modes=modes)
-    except AssertionError as e:
+        summary = main_system(args.left, args.right, args.output, size=args.size, frames=args.frames, modes=modes,
+                              sim=args.sim)
+    except (AssertionError, RuntimeError) as e:
         print(f"error: the system simulation failed ({str(e).splitlines()[0][:200]})", file=sys.stderr)
         return 1
     if args.json:
         args.json.write_text(json.dumps(summary, indent=2) + "\n")
-    print(f"stereo front end, {w}x{h} cameras (18 / 17.9 MHz), memory 100 MHz, Harris 50 MHz (GHDL, simulated time)")
+    print(f"stereo front end, {w}x{h} cameras (18 / 17.9 MHz), memory 100 MHz, Harris 50 MHz "
+          f"({summary['simulator']}, simulated time)")
     for m in modes:
         sh = summary["sram_share"][m]
         print(f"  {m:11s} frames {summary['frames'][m]}  fps {summary['fps'][m]:8.1f}  SRAM busy "
