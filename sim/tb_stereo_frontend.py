@@ -247,10 +247,11 @@ async def frames_bit_exact(dut):
             await drv.configure(mode=mode, thresholds_left=cur[0], thresholds_right=cur[1])
     if mode == "overlapped":
         await drv.stop()
-    for _ in range(1000):
+    # stop ends continuous operation after the frame in progress: up to a camera frame and its rectification
+    for _ in range(max(1000, timeout // 1000)):
         if not (await drv.status())["busy"]:
             break
-        await bus.wait(100)
+        await bus.wait(100 if w * h < 10_000 else 1000)
     else:
         raise AssertionError("the system stays busy after stop")
     st = await drv.status()
