@@ -119,7 +119,7 @@ def figures(rep: dict, timing: CameraTiming) -> dict:
         out["periods_us"] = [round(p / 1e3, 2) for p in periods]
     elif len(done) > 1:  # the steady state: completed frame to completed frame
         out["period_us"] = round((done[-1] - done[0]) / (len(done) - 1) / 1e3, 2)
-        out["period_from"] = f"frame_done to frame_done ({len(done) - 1} intervals)"
+        out["period_from"] = f"frame_done to frame_done, {len(done) - 1} intervals"
     else:
         out["period_us"] = round(rep["total_ns"] / rep["frames_done"] / 1e3, 2)
         out["period_from"] = "run time / frames done"
@@ -306,7 +306,7 @@ def full_section(size: str, figs: dict) -> list[str]:
              f"Against the thesis: its estimate for the sequential system was **{THESIS_FPS} fps**; measured "
              f"**{s['fps']:.2f} fps** ({s['fps'] / THESIS_FPS:.2f} x; period {s['period_from']}). The overlapped "
              f"goal was the cameras' **{1e3 / cam_ms:.1f} fps**: measured **{o['fps']:.2f} fps** "
-             f"({o['period_from']}).", "",
+             f"(period {o['period_from']}).", "",
              "Stage times (simulated; probes on the rectifier's `busy`, the feature list's `frame_done` and the "
              "arbiter's `cam_held` inside the top):", "", *_stage_rows(figs), ""]
     seq_parts = []
@@ -364,7 +364,7 @@ def small_section(size: str, figs: dict, full: dict, measured: dict | None) -> l
              f"frames = {full['sequential_ms']} ms, {full['sequential_fps']} fps" +
              (f" (measured: {measured['sequential']['period_us'] / 1e3:.2f} ms, "
               f"{measured['sequential']['fps']:.2f} fps)" if measured else "") + ";",
-             f"* rectification, scaled: {full['rectify_ms']} ms" +
+             f"* rectification, scaled: {full['rectify_ms'] if full['rectify_ms'] is not None else '(no probe)'} ms" +
              (f" (measured: {measured['sequential']['stages'].get('rectify_us', 0) / 1e3:.2f} ms)" if measured else "")
              + ";",
              f"* host read-out, scaled: {full['host_read_out_ms']} ms" +
@@ -415,6 +415,29 @@ def ghdl_section(speed: dict | None, frame: dict | None, full_figs: dict | None)
     return out
 
 
+#: ``make demo`` from a fresh state, measured by hand (``rm -rf build; time make demo``, ccache disabled so that
+#: Verilator compiles everything as on a fresh machine); update it when the demo changes.
+DEMO = dict(seconds=270, date="2026-12-01", note="the front end 158 s (two Verilator builds of the top and both modes), Sobel 9 s, Harris 48 + 47 s, the rest the set-up's check of the venv; the machine's 2 cores shared with other jobs")
+
+
+def demo_section() -> list[str]:
+    from eyestereo.sim import demo
+
+    w, h = demo.SYSTEM_SIZE
+    out = ["## make demo", "",
+           f"`make demo` runs the complete front end first ({w}x{h} cameras, {demo.SYSTEM_FRAMES} frames in each of "
+           f"the modes {', '.join(demo.SYSTEM_MODES)}, on the fastest simulator here: Verilator on MyHDL's Verilog of "
+           "the top, GHDL if Verilator is missing; `eyestereo sim system`'s pictures: the rectified pair with row "
+           "lines and corners, the matched features coloured by disparity), then the Sobel and Harris VHDL on GHDL "
+           "at 352x288. The size and frame count are chosen to keep it under 5 minutes on 2 cores: a full 352x288 "
+           "system frame alone takes about 5 minutes on Verilator (above)."]
+    if DEMO["seconds"]:
+        out[-1] += (f" Measured from a fresh state (`rm -rf build; time make demo`, ccache disabled, the venv "
+                    f"installed): **{DEMO['seconds'] // 60:.0f} min {DEMO['seconds'] % 60:.0f} s** ({DEMO['date']}; "
+                    f"{DEMO['note']}).")
+    return out + [""]
+
+
 def write_doc(path: Path, *, size: str, figs: dict, small: tuple | None, ghdl: tuple, adaptive=None) -> None:
     lines = ["# The complete front end: frame rate in simulated time", "",
              "Written by `python -m eyestereo.sim.bench_stereo_frontend` (sim/bench_stereo_frontend.py): the "
@@ -427,6 +450,7 @@ def write_doc(path: Path, *, size: str, figs: dict, small: tuple | None, ghdl: t
         lines += small_section(*small, measured=figs if size == "352x288" else None)
     lines += ghdl_section(*ghdl, figs)
     lines += resources_section()
+    lines += demo_section()
     if adaptive is not None:
         lines += adaptive_section(adaptive, path.parent / "img" / "system" / "adaptive.png")
     path.parent.mkdir(parents=True, exist_ok=True)
