@@ -441,12 +441,14 @@ def demo_section() -> list[str]:
         out[-1] += (f" Measured from a fresh state (`rm -rf build; time make demo`, ccache disabled, the venv "
                     f"installed): **{DEMO['seconds'] // 60:.0f} min {DEMO['seconds'] % 60:.0f} s** ({DEMO['date']}; "
                     f"{DEMO['note']}).")
-    out += ["", "Known limit of the demo's matches picture: the demo's pair is two crops of one Tsukuba view (6 px "
-            "apart), not views of the synthetic rig whose calibration (`rig:WxH`) the top rectifies with, so the "
-            "rectified pair is not row-aligned (the two cameras' maps differ by a few rows and a rotation) and "
-            "same-row NCC matching finds few or no matches (none in the measured run). The picture itself is "
-            "checked on a pair with a known disparity (tests/cli/test_cli_sim_system.py); a pair rendered through "
-            "the rig's inverse maps would make it meaningful."]
+    out += ["", "The demo's stereo pair: two crops of one Tsukuba view 6 px apart (4.5 px at 96x72), each rendered "
+            "through the inverse of the synthetic rig's map for its camera (sim/demo.py `rig_view`), so that the top, "
+            "rectifying with the rig's calibration (`rig:WxH`), gives them back row-aligned. (The first timing above "
+            "used the crops as they were: the rectified pair was then not row-aligned and same-row matching found no "
+            "match.) `eyestereo sim system` on that pair, one overlapped frame on Verilator: 64 corners, 13 matched, "
+            "disparities 4..5, bit-exact:", "",
+            "![rectified pair with corners](img/system/rectified.png)", "",
+            "![matched features coloured by disparity](img/system/matches.png)"]
     return out + [""]
 
 

@@ -90,6 +90,23 @@ def run_harris(out: Path, frame: np.ndarray, blocks: tuple[int, int]) -> tuple[n
     return flags * mask, report
 
 
+def rig_view(scene: np.ndarray, side: str) -> np.ndarray:
+    """What the synthetic rig's ``side`` camera sees of ``scene`` (a rectified view): the scene through the
+    inverse of the rig's backward map (fixed-point iteration), so that the top, rectifying with the rig's
+    calibration (``rig:WxH``), gives the scene back row-aligned."""
+    from eyestereo.tools.rectify.synthetic_rig import rig_maps
+
+    h, w = scene.shape
+    m = rig_maps(w, h)
+    mx, my = m[f"{side}_x"].astype(np.float32), m[f"{side}_y"].astype(np.float32)
+    v, u = np.mgrid[0:h, 0:w].astype(np.float32)
+    px, py = u.copy(), v.copy()
+    for _ in range(20):  # p such that M(p) = (u, v)
+        px -= cv2.remap(mx, px, py, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE) - u
+        py -= cv2.remap(my, px, py, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE) - v
+    return cv2.remap(scene, px, py, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+
+
 def write_png(path: Path, img: np.ndarray) -> None:
     if not cv2.imwrite(str(path), img):
         raise OSError(f"cannot write {path}")
@@ -142,8 +159,10 @@ def main(argv=None) -> int:
 
         img = cv2.imread(str(ROOT / "tests" / "data" / IMAGE), cv2.IMREAD_GRAYSCALE)
         lp, rp = out / "system_left.png", out / "system_right.png"
-        write_png(lp, img[100:196, 150:278])
-        write_png(rp, img[100:196, 156:284])
+        w, h = SYSTEM_SIZE
+        scenes = [cv2.resize(img[100:196, x0:x0 + 128], (w, h), interpolation=cv2.INTER_AREA) for x0 in (150, 156)]
+        write_png(lp, rig_view(scenes[0], "left"))
+        write_png(rp, rig_view(scenes[1], "right"))
         w, h = SYSTEM_SIZE
         summary = main_system(lp, rp, out / "system", size=SYSTEM_SIZE, frames=SYSTEM_FRAMES, modes=SYSTEM_MODES,
                               sim=system_sim)
