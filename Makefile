@@ -1,5 +1,5 @@
 # eyestereo: FPGA stereo-vision cores in MyHDL, verified with cocotb on GHDL.
-#   make demo    the main job: real image through the generated Sobel and Harris VHDL in GHDL -> build/demo/
+#   make demo    the main job: the complete stereo front end on a real pair (Verilator), Sobel and Harris VHDL in GHDL -> build/demo/
 #   make test    every test (unit, model, GHDL benches, synthesis checks), 2 workers
 #   make sim SIM=ghdl|icarus|verilator [GHDL_BACKEND=mcode|llvm]   every bench on that simulator
 # Both set everything up on a fresh Debian machine: .venv, the editable install, GHDL.

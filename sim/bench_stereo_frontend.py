@@ -1,16 +1,28 @@
 """Benchmark: the complete front end's frame rate in simulated time, both modes (docs/system.md, build/system/framerate.json).
 
-Runs sim/tb_stereo_frontend.py on GHDL at the thesis's clocks (cameras 18 and 17.9 MHz, memory 100 MHz,
-Harris 50 MHz) for ``--frames`` stereo frames per mode at ``--size`` (a rig calibration of that size),
-the host reading every frame it gets back through the AXI4-Lite bus (15 bus clocks per SRAM word) and
-checking it bit for bit. Measured: the frame period of each mode (sequential: start to start, the host's
-read-out included, one stage after the other; overlapped: frames completed per simulated second), the
-sequencer's FRAME_CLOCKS, the host read-out time and the arbiter's per-master word counts (SRAM share).
-Full 352x288 frames take millions of clocks per frame on GHDL (hours at the ~2-5 k clocks/s this
-machine gives the system), so the full-frame figures are derived from the measured per-pixel costs and
-the camera's real frame period, and the document says so.
+Runs sim/tb_stereo_frontend.py at the thesis's clocks (cameras 18 and 17.9 MHz, memory 100 MHz, Harris
+50 MHz) on the fastest simulator here (Verilator on MyHDL's Verilog of the top, ``--sim``), the host
+reading every frame it gets back through the AXI4-Lite bus (15 bus clocks per SRAM word) and checking it
+bit for bit against the numpy chain:
 
-    python -m eyestereo.sim.bench_stereo_frontend [--size 48x32] [--frames 3] [--out docs/system.md]
+* **full frames** (``--size``, default 352x288 with the OV6630's real blanking: 50 frames/s per camera)
+  in both modes, ``--frames`` host frames per mode (sequential ``--frames``, overlapped ``--frames-ovl``);
+* **small frames** (``--small``, default 48x32, short blanking, 3 frames per mode), from which the old
+  linear-in-pixels derivation of the full-frame figures is kept as a cross-check of the measurement;
+* the **closed threshold loop** (``--adaptive-frames``, sequential, ``--adaptive-size``): the host's
+  SecantController on the FCOUNT window, the feature count settling to its target, plotted;
+* **GHDL's speed** on the full-size top (``--ghdl-speed US``: the bench's speed probe, US microseconds
+  of simulated time on GHDL_BACKEND=llvm) and, if one has been run (``--ghdl-frame MODE``, hours), the
+  full frame on GHDL.
+
+Measured: the frame period of each mode (sequential: start to start, the host's read-out included, one
+stage after the other; overlapped: the interval between completed frames, the feature list's
+``frame_done``), the sequencer's FRAME_CLOCKS, the stage times from probes inside the top, the host
+read-out time, the arbiter's per-master word counts (SRAM share), the wall time and the simulation
+speed. Every run's report is kept in build/system/runs/ (``--reuse`` takes them from there).
+
+    python -m eyestereo.sim.bench_stereo_frontend [--sim verilator] [--size 352x288] [--frames 2]
+        [--small 48x32] [--adaptive-frames 16] [--ghdl-speed 200] [--reuse] [--out docs/system.md]
 """
 
 from __future__ import annotations
@@ -19,55 +31,121 @@ import argparse
 import json
 import sys
 import time
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from eyestereo.sim.runner import ROOT, run_bench
+from eyestereo.sim.runner import ROOT, run_bench, verilator_root
 from eyestereo.tools.camera import CameraTiming
 from eyestereo.tools.models.sram_arbiter import MASTERS
 
 THESIS_FPS = 20.01
 FULL = (352, 288)
 CLOCKS = {"memory": 100.0, "harris": 50.0, "camera_l": 18.0, "camera_r": 17.9}
+#: The blanking of the small frames (the camera model's rules: HREF inactive >= 1 PCLK between lines, a
+#: VSYNC of >= 1 line): real blanking would make a 48x32 frame mostly blanking.
+SHORT = dict(h_blank=64, v_sync=1, v_back=1, v_front=1)
+RUNS = ROOT / "build" / "system" / "runs"
+SPEED_SKIP_US = 1200  # the speed probe's window starts here: the cameras' active lines
+#: What the bench touches in the top (ports and the stage probes): on Verilator only these are public
+#: (run_bench's ``public``), the rest is left to Verilator's optimiser (1.3x at 64x48 here).
+PUBLIC = ["clk", "rst", "hclk", "hrst", "wrst_*", "cam_*", "bus_*", "sram_*", "rectifier*_busy",
+          "frontend_sequencer*_list_done", "sram_subsystem*_cam_held"]
+SIM_NAMES = {"verilator": "Verilator (MyHDL's Verilog of the top)", "icarus": "Icarus Verilog",
+             "ghdl": "GHDL (mcode)", "ghdl-llvm": "GHDL (LLVM back end, -O2)"}
 
 
-def run_mode(mode: str, size: str, frames: int, timing: dict, reuse: bool = False) -> dict:
-    old = ROOT / "build" / "sim" / "stereo_frontend" / f"bench_{mode}_{size}" / "report.json"
-    if reuse and old.is_file():
-        return json.loads(old.read_text())
+def fastest_simulator() -> str:
+    return "verilator" if verilator_root() is not None else "ghdl"
+
+
+def timing_of(size: str) -> dict:
+    """The camera timing of a size: the real OV6630 blanking at 352x288, the short one otherwise."""
+    return {} if tuple(int(v) for v in size.split("x")) == FULL else dict(SHORT)
+
+
+def sim_label(sim: str, backend: str | None = None) -> str:
+    return SIM_NAMES["ghdl-llvm" if sim == "ghdl" and backend == "llvm" else sim]
+
+
+def _kept(tag: str) -> Path:
+    return RUNS / f"{tag}.json"
+
+
+def run_mode(mode: str, size: str, frames: int, timing: dict, sim: str, reuse: bool = False,
+             backend: str | None = None, **extra) -> dict:
+    """One bench run, its report kept in build/system/runs/ (with the wall time and the simulator)."""
+    tag = f"{sim}{'-' + backend if backend else ''}_{mode}_{size}" + ("_speed" if extra.get("speed_us") else "")
+    kept = _kept(tag)
+    if reuse and kept.is_file():
+        rep = json.loads(kept.read_text())
+        if extra.get("speed_us") or len(rep.get("frames", [])) == frames:
+            return rep
+    RUNS.mkdir(parents=True, exist_ok=True)
     t0 = time.time()
+    print(f"[bench] {tag}: {frames} frame(s) on {sim_label(sim, backend)} ...", flush=True)
+    full = tuple(int(v) for v in size.split("x")) == FULL
+    # full frames: a threshold leaving at most 200 features per camera (the lists hold 255)
     rep = run_bench("stereo_frontend", "tb_stereo_frontend",
-                    dict(mode=mode, frames=frames, images="shift:3", timing=timing),
-                    name=f"bench_{mode}_{size}", params=dict(quantizers=f"rig:{size}", feature_words=512,
-                                                              max_features=255))
-    rep["wall_s"] = round(time.time() - t0, 1)
+                    dict(dict(mode=mode, frames=frames, images="shift:3", timing=timing, target=200 if full else 40),
+                         **extra),
+                    name=f"bench_{mode}_{size}" + ("_speed" if extra.get("speed_us") else ""), sim=sim,
+                    backend=backend, params=dict(quantizers=f"rig:{size}", feature_words=512, max_features=255),
+                    log_file=RUNS / f"{tag}.log", public=PUBLIC if sim == "verilator" else None)
+    # the speed probe's own wall_s is the probe's time alone; the run's (build included) beside it
+    rep["wall_total_s" if rep.get("speed") else "wall_s"] = round(time.time() - t0, 1)
+    rep["simulator"] = sim_label(sim, backend)
+    rep.pop("last", None)
+    RUNS.mkdir(parents=True, exist_ok=True)
+    kept.write_text(json.dumps(rep) + "\n")
+    print(f"[bench] {tag}: done in {rep['wall_s']} s", flush=True)
     return rep
 
 
 def figures(rep: dict, timing: CameraTiming) -> dict:
+    """The figures of one run: period, fps, read-out, stage times, SRAM shares, speed."""
     w, h = rep["width"], rep["height"]
     fr = rep["frames"]
     read = [f["read_ns"] - f["frame_ns"] for f in fr]
     out = dict(pixels=w * h, read_out_us=round(sum(read) / len(read) / 1e3, 2),
                frame_clocks=rep["frame_clocks"], camera_frame_us=round(timing.frame_pclk / 18.0, 2))
+    stages = rep.get("stages", {})
+    done = stages.get("list_done_ns") or []
     if rep["mode"] == "sequential":
-        periods = [b["start_ns"] - a["start_ns"] for a, b in zip(fr, fr[1:])]
+        # every frame's period: start to the next start; the last frame's, start to its read-out done (the
+        # next start would follow at once: a release pulse and a start over the bus)
+        periods = [b["start_ns"] - a["start_ns"] for a, b in zip(fr, fr[1:])] + [fr[-1]["read_ns"] - fr[-1]["start_ns"]]
+        out["period_from"] = (f"mean of {len(periods)} frames, start to start" if len(periods) > 1 else
+                              "start to read-out done")
         out["period_us"] = round(sum(periods) / len(periods) / 1e3, 2)
+        out["periods_us"] = [round(p / 1e3, 2) for p in periods]
+    elif len(done) > 1:  # the steady state: completed frame to completed frame
+        out["period_us"] = round((done[-1] - done[0]) / (len(done) - 1) / 1e3, 2)
+        out["period_from"] = f"frame_done to frame_done, {len(done) - 1} intervals"
     else:
         out["period_us"] = round(rep["total_ns"] / rep["frames_done"] / 1e3, 2)
-    out["fps"] = round(1e6 / out["period_us"], 1)
+        out["period_from"] = "run time / frames done"
+    out["fps"] = round(1e6 / out["period_us"], 2)
     moved = {m: rep["arb"][f"moved_{m}"] for m in MASTERS}
     clocks = rep["arb"]["clocks"]
     out["sram_share"] = {m: round(v / clocks, 4) for m, v in moved.items()}
     out["sram_busy"] = round(sum(moved.values()) / clocks, 4)
-    out["stages"] = rep.get("stages", {})
+    out["stages"] = {k: v for k, v in stages.items() if not k.endswith("_ns")}
     out["frames_done"] = rep["frames_done"]
+    out["frames_read"] = len(fr)
     out["bit_exact"] = rep["bit_exact"]
+    out["features"] = [f.get("totals") for f in fr]
+    if rep.get("wall_s"):
+        out["wall_s"] = rep["wall_s"]
+        out["sim_ms"] = round(rep["total_ns"] / 1e6, 2)
+    if rep.get("sim_seconds"):  # cocotb's time of the test (after the build): memory clocks per second
+        out["memory_clocks_per_s"] = round(rep["total_ns"] / 10 / rep["sim_seconds"])
+        out["test_s"] = round(rep["sim_seconds"], 1)
+    out["simulator"] = rep.get("simulator")
     return out
 
 
 def full_frame(seq: dict, ovl: dict) -> dict:
-    """Full 352x288 figures from the measured per-pixel costs (linear in pixels) and the real camera."""
+    """Full 352x288 figures derived from small-frame ones (linear in pixels) and the real camera: the
+    cross-check of the full-frame measurement."""
     cam = CameraTiming()  # the OV6630's 352x288 timing: 50 frames/s at 18 MHz
     cam_ms = cam.frame_pclk / 18e3
     scale = FULL[0] * FULL[1] / seq["pixels"]
@@ -84,20 +162,43 @@ def full_frame(seq: dict, ovl: dict) -> dict:
                 overlapped_fps_bound=round(min(1e3 / cam_ms, 1e3 / read_ms), 1))
 
 
-ADAPTIVE_TARGET = 0.25  # features per block wanted: 4 per camera
+# --- the closed threshold loop ---------------------------------------------------------------------
+ADAPTIVE_TARGET = 4.0  # features per block wanted
+SETTLE_TOL = 0.2       # settled: the total within +-20 % of its target from that frame on
 
 
-def run_adaptive(frames: int, reuse: bool) -> dict:
+def run_adaptive(frames: int, size: str, sim: str, reuse: bool) -> dict:
     """The host's closed threshold loop (SecantController on FCOUNT, thesis 7.2) over ``frames`` frames."""
-    old = ROOT / "build" / "sim" / "stereo_frontend" / "bench_adaptive" / "report.json"
-    if reuse and old.is_file():
-        rep = json.loads(old.read_text())
+    tag = f"{sim}_adaptive_{size}"
+    kept = _kept(tag)
+    if reuse and kept.is_file():
+        rep = json.loads(kept.read_text())
         if len(rep["frames"]) == frames:
             return rep
-    return run_bench("stereo_frontend", "tb_stereo_frontend",
-                     dict(mode="sequential", frames=frames, images="shift:3", adaptive=ADAPTIVE_TARGET,
-                          timing=dict(h_blank=8, v_sync=1, v_back=1, v_front=1)),
-                     name="bench_adaptive", params=dict(quantizers="rig:32x24", feature_words=256, max_features=127))
+    RUNS.mkdir(parents=True, exist_ok=True)
+    t0 = time.time()
+    print(f"[bench] {tag}: {frames} frames on {sim_label(sim)} ...", flush=True)
+    # the initial thresholds leave at most 8 features per camera: the loop has to pull the count up
+    rep = run_bench("stereo_frontend", "tb_stereo_frontend",
+                    dict(mode="sequential", frames=frames, images="shift:3", adaptive=ADAPTIVE_TARGET, target=8,
+                         timing=dict(SHORT, h_blank=8)),
+                    name=f"bench_adaptive_{size}", sim=sim,
+                    params=dict(quantizers=f"rig:{size}", feature_words=512, max_features=255),
+                    log_file=RUNS / f"{tag}.log", public=PUBLIC if sim == "verilator" else None)
+    rep["wall_s"] = round(time.time() - t0, 1)
+    rep["simulator"] = sim_label(sim)
+    rep["size"] = size
+    rep.pop("last", None)
+    RUNS.mkdir(parents=True, exist_ok=True)
+    kept.write_text(json.dumps(rep) + "\n")
+    return rep
+
+
+def settling(totals: list[int], target: float, tol: float = SETTLE_TOL) -> int | None:
+    """The first frame from which every total stays within +-tol * target (None: never)."""
+    from eyestereo.tools.matching.adaptive import settling_frames
+
+    return settling_frames(totals, 0, target, tol=tol)
 
 
 def adaptive_section(rep: dict, img: Path) -> list[str]:
@@ -108,81 +209,262 @@ def adaptive_section(rep: dict, img: Path) -> list[str]:
 
     tot = [f["totals"] for f in rep["frames"]]
     target = 16 * ADAPTIVE_TARGET
-    fig, ax = plt.subplots(figsize=(5, 3), dpi=90)
+    s_l, s_r = settling([t[0] for t in tot], target), settling([t[1] for t in tot], target)
+    fig, ax = plt.subplots(figsize=(6, 3.2), dpi=90)
     ax.plot([t[0] for t in tot], "o-", label="left")
     ax.plot([t[1] for t in tot], "s-", label="right")
     ax.axhline(target, color="k", ls="--", label="target")
+    ax.axhspan(target * (1 - SETTLE_TOL), target * (1 + SETTLE_TOL), color="0.9", label=f"±{SETTLE_TOL:.0%}")
     ax.set_xlabel("frame")
     ax.set_ylabel("features (FEATURES register)")
-    ax.legend()
+    ax.set_title(f"closed loop on {rep.get('simulator', '?')}, {rep.get('size', '?')}", fontsize=9)
+    ax.legend(fontsize=8)
     fig.tight_layout()
     img.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(img)
     plt.close(fig)
-    rows = [f"| {i} | {t[0]} | {t[1]} | {max(f['thresholds'][0])} | {max(f['thresholds'][1])} |"
+    rows = [f"| {i} | {f['rect_pair'][0]} | {t[0]} | {t[1]} | {min(f['thresholds'][0])}..{max(f['thresholds'][0])} | "
+            f"{min(f['thresholds'][1])}..{max(f['thresholds'][1])} |"
             for i, (t, f) in enumerate(zip(tot, rep["frames"]))]
+
+    def said(s):
+        return f"from frame {s} on" if s is not None else "not within the run"
+
+    size = rep.get("size", "?")
     return ["## Closed-loop adaptive thresholds", "",
-            "Sequential mode, 32x24 cameras, the host running the matching package's `SecantController` "
-            f"(tools/matching/adaptive.py) on the FCOUNT window: target {ADAPTIVE_TARGET} features per block "
-            f"({target:.0f} per camera); each frame's 16 + 16 thresholds written over the bus before the next "
-            "start; every frame bit-exact with the model run on the thresholds it ran with.", "",
+            f"Sequential mode, {size} cameras ({len(tot)} consecutive frames of a moving random-texture scene: "
+            "the scene moves a pixel per camera frame, so every block's content changes from frame to frame), "
+            f"{rep.get('simulator', '?')}, {rep.get('wall_s', '?')} s wall. The host runs the matching package's "
+            f"`SecantController` (tools/matching/adaptive.py) on the FCOUNT window: target {ADAPTIVE_TARGET:g} "
+            f"features per block ({target:.0f} per camera); each frame's 16 + 16 thresholds are written over the "
+            "bus before the next start, and every frame is bit-exact with the model run on the thresholds it ran "
+            "with. The first thresholds (one code for all blocks, chosen with the model) leave at most 8 features "
+            "per camera: the loop has to find the target from far below.", "",
+            f"**Settling criterion:** the camera's total (FEATURES) stays within ±{SETTLE_TOL:.0%} of the target "
+            f"({target * (1 - SETTLE_TOL):.0f}..{target * (1 + SETTLE_TOL):.0f}) from that frame to the end of the "
+            f"run. Measured: left {said(s_l)}, right {said(s_r)}.", "",
             f"![adaptive](img/system/{img.name})", "",
-            "| frame | features left | features right | largest threshold code left | right |",
-            "|---:|---:|---:|---:|---:|", *rows, "",
-            f"After {len(tot)} frames the counts are {tot[-1][0]} and {tot[-1][1]} against {target:.0f}: the loop "
-            "moves the thresholds the right way (codes up by up to 16x a frame, the controller's max_step) but this "
-            "short run on a tiny, sparse scene does not show it settled; a longer sequence is the next "
-            "measurement (each sequential frame costs ~3 minutes of GHDL here).", ""]
+            "| frame | camera frame captured | features left | features right | threshold codes left | right |",
+            "|---:|---:|---:|---:|---:|---:|", *rows, ""]
 
 
-def write_doc(path: Path, size: str, reps: dict, figs: dict, full: dict, timing: dict, adaptive=None) -> None:
-    s, o = figs["sequential"], figs["overlapped"]
-    lines = ["# The complete front end: frame rate in simulated time", "",
-             "Written by `python -m eyestereo.sim.bench_stereo_frontend` (sim/bench_stereo_frontend.py). GHDL "
-             f"(mcode), the stereo_frontend top level at {size} (calibration `rig:{size}`), cameras at 18 and "
-             "17.9 MHz (independent clocks), memory clock 100 MHz, Harris clock 50 MHz; the host reads every "
-             "frame it gets back through the AXI4-Lite bus and the bench compares it bit for bit with the numpy "
-             f"chain. Camera timing of the small frames: {timing}.", "",
-             "## Measured (simulated time)", "",
-             "| mode | frames (host read) | frames done | frame period | fps | FRAME_CLOCKS | host read-out | "
-             "bit-exact |", "|---|---:|---:|---:|---:|---:|---:|---|"]
+# --- the document ----------------------------------------------------------------------------------
+def _mode_rows(figs: dict) -> list[str]:
+    rows = ["| mode | frames (host read) | frames done | frame period | fps | FRAME_CLOCKS | host read-out | "
+            "bit-exact |", "|---|---:|---:|---:|---:|---:|---:|---|"]
     for m, f in figs.items():
-        lines.append(f"| {m} | {len(reps[m]['frames'])} | {f['frames_done']} | {f['period_us']} us | {f['fps']} | "
-                     f"{f['frame_clocks']} | {f['read_out_us']} us | {'yes' if f['bit_exact'] else 'no'} |")
-    lines += ["", "Stage times (means over the frames, simulated time; probes on the rectifier's `busy`, the feature "
-              "list's `frame_done` and the arbiter's `cam_held` inside the converted top):", "",
-              "| mode | start to pair held (capture) | rectification | lists complete after the rectifier | "
-              "host read-out |", "|---|---:|---:|---:|---:|"]
+        rows.append(f"| {m} | {f['frames_read']} | {f['frames_done']} | {f['period_us'] / 1e3:.3f} ms | "
+                    f"**{f['fps']:.2f}** | {f['frame_clocks']} | {f['read_out_us'] / 1e3:.3f} ms | "
+                    f"{'yes' if f['bit_exact'] else 'no'} |")
+    return rows
+
+
+def _stage_rows(figs: dict) -> list[str]:
+    rows = ["| mode | start to pair held (capture) | rectification | lists complete after the rectifier | "
+            "host read-out |", "|---|---:|---:|---:|---:|"]
     for m, f in figs.items():
         st = f["stages"]
-        cap = f"{st.get('capture_us')} us" if m == "sequential" else "(overlapped)"
-        lines.append(f"| {m} | {cap} | {st.get('rectify_us')} us | {st.get('lists_after_rectifier_us')} us | "
-                     f"{f['read_out_us']} us |")
-    lines += ["", "Sequential: start to start, each frame armed, captured (waiting for the next VSYNC, then one "
-              "camera frame), rectified (Harris and the lists follow), read out by the host and released before "
-              "the next start. Overlapped: frames completed per simulated second while the host reads what it can "
-              "(it holds one rectified pair and one list at a time; the system keeps capturing).", "",
-              "SRAM share of each master (words moved / memory clocks, the arbiter's counters):", "",
-              "| mode | " + " | ".join(MASTERS) + " | all |", "|---|" + "---:|" * (len(MASTERS) + 1)]
+
+        def ms(v):
+            return "-" if v is None else f"{v / 1e3:.3f} ms"
+
+        cap = ms(st.get("capture_us")) if m == "sequential" else "(overlapped)"
+        rows.append(f"| {m} | {cap} | {ms(st.get('rectify_us'))} | {ms(st.get('lists_after_rectifier_us'))} | "
+                    f"{ms(f['read_out_us'])} |")
+    return rows
+
+
+def _share_rows(figs: dict) -> list[str]:
+    rows = ["| mode | " + " | ".join(MASTERS) + " | all |", "|---|" + "---:|" * (len(MASTERS) + 1)]
     for m, f in figs.items():
-        lines.append(f"| {m} | " + " | ".join(f"{100 * f['sram_share'][x]:.1f} %" for x in MASTERS) +
-                     f" | {100 * f['sram_busy']:.1f} % |")
-    lines += ["", "## Full 352x288 frames (derived, not simulated)", "",
-              "Not run on GHDL here: a full frame is ~4 M memory clocks with the host's read-out, hours at this "
-              "machine's simulation speed. Derived from the measured figures above, linear in pixels:", "",
-              f"* camera frame (OV6630 timing, 18 MHz): {full['camera_ms']} ms (50 fps: the cameras' limit);",
-              f"* sequential: (measured period - 1.5 camera frames) x {FULL[0] * FULL[1]} / pixels + 1.5 full camera "
-              f"frames (arming waits on average half a frame for VSYNC) = {full['sequential_ms']} ms, "
-              f"**{full['sequential_fps']} fps** against the thesis's estimate of {THESIS_FPS} fps;",
-              f"* rectification (measured per pixel, scaled): {full['rectify_ms']} ms;",
-              f"* host read-out of one frame (rectified pair packed, lists) through the bus: {full['host_read_out_ms']}"
-              f" ms; overlapped, bounded by the slower of the camera and the read-out: "
-              f"**{full['overlapped_fps_bound']} fps** (goal: the cameras' 50 fps; "
-              + ("the cameras are the limit: the read-out, at 15 bus clocks per SRAM word, keeps up with "
-                 f"{100 * (1 - full['host_read_out_ms'] / full['camera_ms']):.0f} % to spare" if full['host_read_out_ms']
-                 < full['camera_ms'] else "the host read-out of 15 bus clocks per word is the limit; a burst "
-                 "host port would lift it") + "; a full frame in the overlapped mode has not been simulated).", ""]
+        rows.append(f"| {m} | " + " | ".join(f"{100 * f['sram_share'][x]:.1f} %" for x in MASTERS) +
+                    f" | {100 * f['sram_busy']:.1f} % |")
+    return rows
+
+
+def _speed_rows(figs: dict) -> list[str]:
+    rows = ["| mode | simulator | simulated | wall (build + run) | test alone | memory clocks / s |",
+            "|---|---|---:|---:|---:|---:|"]
+    for m, f in figs.items():
+        rows.append(f"| {m} | {f.get('simulator')} | {f.get('sim_ms')} ms | {f.get('wall_s')} s | "
+                    f"{f.get('test_s')} s | {f.get('memory_clocks_per_s')} |")
+    return rows
+
+
+def full_section(size: str, figs: dict) -> list[str]:
+    s, o = figs["sequential"], figs["overlapped"]
+    cam = CameraTiming(*(int(v) for v in size.split("x"))) if size != "352x288" else CameraTiming()
+    cam_ms = cam.frame_pclk / 18e3
+    st = s["stages"]
+    lines = [f"## Full {size} frames through the whole system (measured, simulated time)", "",
+             f"{s.get('simulator')}; the OV6630's real timing ({cam.frame_pclk} PCLK a frame: "
+             f"{cam_ms:.2f} ms at 18 MHz, **{1e3 / cam_ms:.1f} fps**, the cameras' limit), a moving random-texture "
+             "scene (`shift:3`), the host reading every frame it takes back (the rectified pair packed, both "
+             "feature lists) over AXI4-Lite and the bench comparing it bit for bit with the numpy chain (camera "
+             "model -> rectification model -> stereo Harris model -> feature list).", "",
+             *_mode_rows(figs), "",
+             f"Against the thesis: its estimate for the sequential system was **{THESIS_FPS} fps**; measured "
+             f"**{s['fps']:.2f} fps** ({s['fps'] / THESIS_FPS:.2f} x; period {s['period_from']}). The overlapped "
+             f"goal was the cameras' **{1e3 / cam_ms:.1f} fps**: measured **{o['fps']:.2f} fps** "
+             f"(period {o['period_from']}).", "",
+             "Stage times (simulated; probes on the rectifier's `busy`, the feature list's `frame_done` and the "
+             "arbiter's `cam_held` inside the top):", "", *_stage_rows(figs), ""]
+    seq_parts = []
+    if st.get("capture_us") is not None and st.get("rectify_us") is not None:
+        seq_parts = [f"Sequential, one stage after the other: the cameras are armed and their next frames captured "
+                     f"({st['capture_us'] / 1e3:.2f} ms from start to the pair held, the camera's active lines being "
+                     f"{cam.height * (2 * cam.width + cam.h_blank) / 18e3:.2f} ms of its {cam_ms:.2f} ms frame), then "
+                     f"the rectification ({st['rectify_us'] / 1e3:.2f} ms; Harris and the lists are complete "
+                     f"{st.get('lists_after_rectifier_us', 0) / 1e3:.3f} ms after it), then the host's read-out through "
+                     f"the bus ({s['read_out_us'] / 1e3:.2f} ms, 15 bus clocks per SRAM word), then the next start."]
+    if s.get("periods_us"):
+        seq_parts += ["", "Sequential periods frame by frame: " + ", ".join(f"{v / 1e3:.2f}" for v in s["periods_us"]) +
+                      f" ms. A camera frame is captured from its first active line (camera_in: a frame is taken when "
+                      f"it *starts* while armed), so arming during VSYNC or the back porch ({cam.v_sync + cam.v_back} "
+                      f"lines, {(cam.v_sync + cam.v_back) * (2 * cam.width + cam.h_blank) / 18e3:.2f} ms) still takes "
+                      "that frame. Capture of the active lines, rectification and read-out take just over two camera "
+                      f"frames ({2 * cam_ms:.2f} ms), so the next start falls just after the next-but-one VSYNC and "
+                      "the period settles at two camera frames, while both cameras' first lines are still ahead; the "
+                      "two cameras drift apart (18 / 17.9 MHz: 0.11 ms a frame), and when one's first line has just "
+                      "passed the frame waits a whole camera frame longer.",
+                      "", "Stage by stage against the thesis's estimate (section 7.1's transfer times; its 20.01 fps "
+                      "leaves out arbitration and waiting):", "",
+                      "| stage | thesis estimate | measured |", "|---|---:|---:|",
+                      f"| image transfer into the SRAM (both cameras) | 11.26 ms (overlapped) | "
+                      f"{st['capture_us'] / 1e3:.2f} ms from start to the pair held (the camera's active lines) |",
+                      f"| rectification: reads of both frames and the rectified writes | 20.28 + 2.02 ms | "
+                      f"{st['rectify_us'] / 1e3:.2f} ms (rectifier busy) |",
+                      f"| Harris and the feature lists | (in the stream) | +{st['lists_after_rectifier_us'] / 1e3:.3f} "
+                      "ms after the rectifier |",
+                      f"| host transfer of the rectified pair and the features | 16.22 ms | {s['read_out_us'] / 1e3:.2f} "
+                      "ms (AXI4-Lite, 15 bus clocks per SRAM word) |",
+                      f"| frame period | 49.97 ms (20.01 fps) | {s['period_us'] / 1e3:.2f} ms ({s['fps']:.2f} fps) |"]
+    read_ms = o["read_out_us"] / 1e3
+    lim = ("the cameras are the limit (the read-out of a frame takes "
+           f"{read_ms:.2f} ms of the {cam_ms:.2f} ms camera frame)" if read_ms < cam_ms else
+           f"the host's read-out ({read_ms:.2f} ms a frame at 15 bus clocks per SRAM word, longer than the "
+           f"{cam_ms:.2f} ms camera frame) is the limit; a burst host port (or DMA) would lift it")
+    lines += seq_parts + ["", f"Overlapped: {lim}.", "",
+                          "SRAM share of each master (words moved / memory clocks over the run, the arbiter's "
+                          "counters):", "", *_share_rows(figs), "",
+                          "Simulation (one run at a time, `nice`, on a 2-core machine shared with other jobs):", "",
+                          *_speed_rows(figs), ""]
+    return lines
+
+
+def small_section(size: str, figs: dict, full: dict, measured: dict | None) -> list[str]:
+    lines = [f"## Small frames ({size}) and the derived full-frame figures (cross-check)", "",
+             f"{figs['sequential'].get('simulator')}, {size} (calibration `rig:{size}`), short blanking {SHORT} "
+             "(the camera model's rules allow it: HREF inactive for at least one PCLK between lines, VSYNC for at "
+             "least one line), the same bench.", "", *_mode_rows(figs), "", *_stage_rows(figs), "",
+             *_share_rows(figs), "",
+             "Derived from these small frames for 352x288, linear in pixels (what this document gave before the "
+             "full frames were simulated; kept only as a cross-check of the measurement above):", "",
+             f"* sequential: (measured period - 1.5 camera frames) x {FULL[0] * FULL[1]} / pixels + 1.5 full camera "
+             f"frames = {full['sequential_ms']} ms, {full['sequential_fps']} fps" +
+             (f" (measured: {measured['sequential']['period_us'] / 1e3:.2f} ms, "
+              f"{measured['sequential']['fps']:.2f} fps)" if measured else "") + ";",
+             f"* rectification, scaled: {full['rectify_ms'] if full['rectify_ms'] is not None else '(no probe)'} ms" +
+             (f" (measured: {measured['sequential']['stages'].get('rectify_us', 0) / 1e3:.2f} ms)" if measured else "")
+             + ";",
+             f"* host read-out, scaled: {full['host_read_out_ms']} ms" +
+             (f" (measured: {measured['overlapped']['read_out_us'] / 1e3:.2f} ms)" if measured else "") +
+             f"; overlapped bound: {full['overlapped_fps_bound']} fps" +
+             (f" (measured: {measured['overlapped']['fps']:.2f} fps)" if measured else "") + ".", ""]
+    return lines
+
+
+def ghdl_section(speed: dict | None, frame: dict | None, full_figs: dict | None) -> list[str]:
+    out = ["## On GHDL", ""]
+    if frame is not None:
+        f = frame
+        out += [f"A full 352x288 frame on {f['simulator']}, {f['mode']}: {f['frames_read']} frame(s) read back, "
+                f"bit-exact: {'yes' if f['bit_exact'] else 'no'}; period {f['period_us'] / 1e3:.3f} ms "
+                f"({f['fps']:.2f} fps; frame 0, start to read-out done" +
+                (f": Verilator's frame 0 took {full_figs['sequential']['periods_us'][0] / 1e3:.3f} ms on a "
+                 "different random scene (the bench's scene depends on the number of frames), the read-out's length "
+                 "depending on the features" if full_figs and
+                 full_figs['sequential'].get('periods_us') else "") +
+                f"), {f['wall_s']} s wall ({f['wall_s'] / 60:.0f} minutes), {f.get('memory_clocks_per_s')} memory "
+                "clocks/s over the whole run.", ""]
+    if speed is not None:
+        need = None
+        v = speed.get("verilator")
+        if full_figs and v and full_figs["sequential"].get("test_s"):
+            s = full_figs["sequential"]
+            # Verilator's time per full frame, and the same with the simulator's share slowed down by the probe's
+            # ratio: between "only the simulator's own part is slower" and "everything is slower"
+            per = s["test_s"] / s["frames_read"]
+            clocks = s["period_us"] * 100
+            low = per + clocks * (1 / speed["memory_clocks_per_s"] - 1 / v["memory_clocks_per_s"])
+            high = per * v["memory_clocks_per_s"] / speed["memory_clocks_per_s"]
+            need = (low, high)
+        out += [f"Speed, the bench's probe (`speed_us`): the full-size top from {SPEED_SKIP_US / 1e3:.1f} ms on (both "
+                f"cameras sending their active lines into the SRAM, the SRAM model and the host's polling running), "
+                f"{speed['sim_us']:.0f} us of simulated time: {speed['simulator']} at "
+                f"**{speed['memory_clocks_per_s']:.0f} memory clocks per second** ({speed['wall_s']} s; "
+                f"{speed.get('wall_total_s')} s with analysis, elaboration and set-up)" +
+                (f", {v['simulator']} at **{v['memory_clocks_per_s']:.0f}** ({v['wall_s']} s; {v.get('wall_total_s')} s "
+                 "with its build)" if v else "") + ". The whole full-frame runs above averaged "
+                f"{full_figs['sequential'].get('memory_clocks_per_s') if full_figs else '?'} (sequential) and "
+                f"{full_figs['overlapped'].get('memory_clocks_per_s') if full_figs else '?'} (overlapped) memory clocks "
+                "per second on Verilator, the host's bus read-out (cocotbext-axi, a Python coroutine step per bus "
+                "clock) included." +
+                (f" Projected for one sequential 352x288 frame (the {s['period_us'] / 1e3:.2f} ms measured above, "
+                 f"{s['period_us'] * 100:.0f} memory clocks; Verilator took {per:.0f} s a frame): "
+                 f"**{need[0] / 60:.0f} to {need[1] / 60:.0f} minutes** on {speed['simulator']} (the lower figure if only "
+                 "the simulator's own share slows down, the higher if everything did)." if need else ""), ""]
+    if frame is None:
+        out += ["No full frame has been run on GHDL: it did not fit in the time this session had on a 2-core machine "
+                "shared with other jobs (the projection above). `python -m eyestereo.sim.bench_stereo_frontend "
+                "--ghdl-frame sequential --reuse` runs one (one frame, bit-exact check) and adds it here.", ""]
+    return out
+
+
+#: ``make demo`` from a fresh state, measured by hand (``rm -rf build; time make demo``, ccache disabled so that
+#: Verilator compiles everything as on a fresh machine); update it when the demo changes.
+DEMO = dict(seconds=232, date="2026-12-01", note="the front end 121 s (two Verilator builds of the top and both modes), Sobel 10 s, Harris 48 + 51 s; an earlier run, before the rig views and with the set-up reinstalling the venv's packages, took 270 s; the machine's 2 cores shared with other jobs")
+
+
+def demo_section() -> list[str]:
+    from eyestereo.sim import demo
+
+    w, h = demo.SYSTEM_SIZE
+    out = ["## make demo", "",
+           f"`make demo` runs the complete front end first ({w}x{h} cameras, {demo.SYSTEM_FRAMES} frames in each of "
+           f"the modes {', '.join(demo.SYSTEM_MODES)}, on the fastest simulator here: Verilator on MyHDL's Verilog of "
+           "the top, GHDL if Verilator is missing; `eyestereo sim system`'s pictures: the rectified pair with row "
+           "lines and corners, the matched features coloured by disparity), then the Sobel and Harris VHDL on GHDL "
+           "at 352x288. The size and frame count are chosen to keep it under 5 minutes on 2 cores: a full 352x288 "
+           "system frame alone takes about 5 minutes on Verilator (above)."]
+    if DEMO["seconds"]:
+        out[-1] += (f" Measured from a fresh state (`rm -rf build; time make demo`, ccache disabled, the venv "
+                    f"installed): **{DEMO['seconds'] // 60:.0f} min {DEMO['seconds'] % 60:.0f} s** ({DEMO['date']}; "
+                    f"{DEMO['note']}).")
+    out += ["", "The demo's stereo pair: two crops of one Tsukuba view 6 px apart (4.5 px at 96x72), each rendered "
+            "through the inverse of the synthetic rig's map for its camera (sim/demo.py `rig_view`), so that the top, "
+            "rectifying with the rig's calibration (`rig:WxH`), gives them back row-aligned. (The first timing above "
+            "used the crops as they were: the rectified pair was then not row-aligned and same-row matching found no "
+            "match.) `eyestereo sim system` on that pair, one overlapped frame on Verilator: 64 corners, 13 matched, "
+            "disparities 4..5, bit-exact:", "",
+            "![rectified pair with corners](img/system/rectified.png)", "",
+            "![matched features coloured by disparity](img/system/matches.png)"]
+    return out + [""]
+
+
+def write_doc(path: Path, *, size: str, figs: dict, small: tuple | None, ghdl: tuple, adaptive=None) -> None:
+    lines = ["# The complete front end: frame rate in simulated time", "",
+             "Written by `python -m eyestereo.sim.bench_stereo_frontend` (sim/bench_stereo_frontend.py): the "
+             "stereo_frontend top level, two camera models with independent clocks (18 and 17.9 MHz), memory clock "
+             "100 MHz (SRAM model checking the part's rules), Harris clock 50 MHz; the host driver configures the "
+             "registers, waits for frames, reads every frame it takes back through the AXI4-Lite bus and the bench "
+             "compares it bit for bit with the numpy chain.", ""]
+    lines += full_section(size, figs)
+    if small is not None:
+        lines += small_section(*small, measured=figs if size == "352x288" else None)
+    lines += ghdl_section(*ghdl, figs)
     lines += resources_section()
+    lines += demo_section()
     if adaptive is not None:
         lines += adaptive_section(adaptive, path.parent / "img" / "system" / "adaptive.png")
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -191,24 +473,24 @@ def write_doc(path: Path, size: str, reps: dict, figs: dict, full: dict, timing:
 
 #: The Spartan-3E 500 (XC3S500E).
 DEVICE = dict(LUT=9312, FF=9312, RAMB16=20, MULT18X18=20)
+#: make synth's figures of the default top, used when build/synth/resources.json is not there (docs/benchmarks.md)
+SYNTH_FALLBACK = dict(LUT=5941, LUTRAM=252, FF=6186, RAMB16=16, MULT18X18=19)
 
 
 def resources_section() -> list[str]:
     """The whole system's resources against the Spartan-3E 500, from make synth's resources.json (the
-    default stereo_frontend: 352x288, the synthetic rig's calibration), if it has been run."""
+    default stereo_frontend: 352x288, the synthetic rig's calibration), or the figures measured before."""
     f = ROOT / "build" / "synth" / "resources.json"
     rows = [r for r in (json.loads(f.read_text()) if f.is_file() else []) if r.get("block") == "stereo_frontend"
             and not r.get("params")]
     out = ["## Resources of the whole system", ""]
-    if not rows:
-        return out + ["Not measured yet: run `python -m eyestereo.hdl.synth --block stereo_frontend --no-pnr`, then "
-                      "this benchmark with `--reuse`.", ""]
-    s = rows[-1]["summary"]
+    s = rows[-1]["summary"] if rows else SYNTH_FALLBACK
     luts = s["LUT"] + s["LUTRAM"]  # distributed RAM occupies LUTs of SLICEMs
     used = dict(LUT=luts, FF=s["FF"], RAMB16=s["RAMB16"], MULT18X18=s["MULT18X18"])
     out += ["`python -m eyestereo.hdl.synth --block stereo_frontend --no-pnr`: GHDL's synthesis of the generated VHDL "
             "(the default top: 352x288 cameras, the synthetic rig's calibration, harris_stereo share 1, nms 3, "
-            "1024-word camera FIFOs), Yosys `synth_xilinx -family xc3se`, not placed.", "",
+            "1024-word camera FIFOs), Yosys `synth_xilinx -family xc3se`, not placed" +
+            ("" if rows else " (figures of the last run; build/synth/resources.json not present)") + ".", "",
             "| resource | used | Spartan-3E 500 | share | margin |", "|---|---:|---:|---:|---:|"]
     for k, cap in DEVICE.items():
         note = f" ({s['LUT']} logic + {s['LUTRAM']} LUT-RAM)" if k == "LUT" else ""
@@ -217,41 +499,106 @@ def resources_section() -> list[str]:
     out += ["", f"It {'fits' if fits else 'does not fit'}: the multipliers are the tight resource (rectifier 12, "
             "harris_stereo at share 1 7); share 2 would free 3 but cannot take the rectifier's stream without a "
             "pacing buffer. Carry cells (MUXCY/XORCY) use no LUT. Yosys counts, not ISE's: the thesis's own "
-            "figures came from ISE 10.", ""]
+            "figures came from ISE 10.", "",
+            "`make synth` on the merged main (after cornerness_stereo's Verilog-safe subtraction, "
+            "docs/benchmarks.md) measured the same top at 5770 LUT + 252 LUT-RAM, 6186 FF, 16 RAMB16, 19 MULT18X18, "
+            "and placed it on an ECP5 (LFE5U-85F): memory clock 81.0 MHz (below the 100 MHz goal), Harris clock "
+            "84.0 MHz, camera clocks 122.8 / 132.7 MHz.", ""]
     return out
+
+
+def _size(text: str) -> str:
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected WxH like 48x32, got {text!r}") from None
+    if not (16 <= w <= 352 and 16 <= h <= 288 and w % 2 == 0):
+        raise argparse.ArgumentTypeError(f"size {text}: width even, 16..352 x 16..288")
+    return f"{w}x{h}"
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--size", default="48x32")
-    ap.add_argument("--frames", type=int, default=3)
+    ap.add_argument("--sim", choices=("verilator", "icarus", "ghdl"), default=None,
+                    help="simulator of the runs (default: the fastest here, Verilator if installed)")
+    ap.add_argument("--size", type=_size, default="352x288")
+    ap.add_argument("--frames", type=int, default=2, help="host frames of the sequential run (default 2)")
+    ap.add_argument("--frames-ovl", type=int, default=3, help="host frames of the overlapped run (default 3)")
+    ap.add_argument("--small", type=_size, default="48x32", help="the small frames' size (cross-check)")
+    ap.add_argument("--no-small", action="store_true", help="leave the small frames out")
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "system.md")
     ap.add_argument("--json", type=Path, default=ROOT / "build" / "system" / "framerate.json")
     ap.add_argument("--adaptive-frames", type=int, default=0,
-                    help="also run the closed threshold loop (sequential, 32x24) for this many frames")
-    ap.add_argument("--reuse", action="store_true", help="take the benches' reports from build/ if they are there")
+                    help="also run the closed threshold loop (sequential, --adaptive-size) for this many frames")
+    ap.add_argument("--adaptive-size", type=_size, default="64x48")
+    ap.add_argument("--ghdl-speed", type=int, default=0, metavar="US",
+                    help="measure GHDL's (llvm) speed on the full-size top over US microseconds of simulated time")
+    ap.add_argument("--ghdl-frame", choices=("sequential", "overlapped"),
+                    help="also run one full frame on GHDL (llvm): hours")
+    ap.add_argument("--reuse", action="store_true", help="take the runs' reports from build/system/runs/ if there")
     args = ap.parse_args(argv)
-    timing = dict(h_blank=64, v_sync=1, v_back=1, v_front=1)
-    with ThreadPoolExecutor(2) as ex:
-        futs = {m: ex.submit(run_mode, m, args.size, args.frames, timing, args.reuse) for m in ("sequential", "overlapped")}
-        reps = {m: f.result() for m, f in futs.items()}
-    w, h = (int(v) for v in args.size.split("x"))
-    ct = CameraTiming(width=w, height=h, **timing)
-    figs = {m: figures(r, ct) for m, r in reps.items()}
-    full = full_frame(figs["sequential"], figs["overlapped"])
-    adaptive = run_adaptive(args.adaptive_frames, args.reuse) if args.adaptive_frames else None
-    write_doc(args.out, args.size, reps, figs, full, timing, adaptive)
+    if args.frames < 1 or args.frames_ovl < 1:
+        print("error: --frames and --frames-ovl must be at least 1", file=sys.stderr)
+        return 1
+    if args.adaptive_frames < 0 or args.ghdl_speed < 0:
+        print("error: --adaptive-frames and --ghdl-speed must not be negative", file=sys.stderr)
+        return 1
+    sim = args.sim or fastest_simulator()
+    try:
+        # one simulation at a time (the machine has 2 cores; a Verilator build uses both)
+        timing = timing_of(args.size)
+        reps = {"sequential": run_mode("sequential", args.size, args.frames, timing, sim, args.reuse),
+                "overlapped": run_mode("overlapped", args.size, args.frames_ovl, timing, sim, args.reuse)}
+        w, h = (int(v) for v in args.size.split("x"))
+        figs = {m: figures(r, CameraTiming(width=w, height=h, **timing)) for m, r in reps.items()}
+        small = None
+        if not args.no_small:
+            sreps = {m: run_mode(m, args.small, 3, SHORT, sim, args.reuse) for m in ("sequential", "overlapped")}
+            sw, sh = (int(v) for v in args.small.split("x"))
+            sfigs = {m: figures(r, CameraTiming(width=sw, height=sh, **SHORT)) for m, r in sreps.items()}
+            small = (args.small, sfigs, full_frame(sfigs["sequential"], sfigs["overlapped"]))
+        from eyestereo.sim.runner import fastest_ghdl_backend
+
+        backend = fastest_ghdl_backend()
+        speed = frame = None
+        speed_file = _kept(f"ghdl-{backend}_sequential_352x288_speed")
+        if args.ghdl_speed:
+            # the same window on both simulators: from 1.2 ms (the cameras' active lines, both writing into
+            # the SRAM) on, ``--ghdl-speed`` microseconds
+            speed = run_mode("sequential", "352x288", 1, {}, "ghdl", False, backend=backend, speed_us=args.ghdl_speed,
+                             speed_skip_us=SPEED_SKIP_US)
+            speed["verilator"] = run_mode("sequential", "352x288", 1, {}, "verilator", False, speed_us=args.ghdl_speed,
+                                          speed_skip_us=SPEED_SKIP_US)
+            _kept(f"ghdl-{backend}_sequential_352x288_speed").write_text(json.dumps(speed) + "\n")
+        elif speed_file.is_file():
+            speed = json.loads(speed_file.read_text())
+        for mode in ("sequential", "overlapped"):
+            f = _kept(f"ghdl-{backend}_{mode}_352x288")
+            if args.ghdl_frame == mode:
+                rep = run_mode(mode, "352x288", 1, {}, "ghdl", args.reuse, backend=backend)
+            elif f.is_file():
+                rep = json.loads(f.read_text())
+            else:
+                continue
+            frame = dict(figures(rep, CameraTiming()), mode=mode)
+        adaptive = run_adaptive(args.adaptive_frames, args.adaptive_size, sim, args.reuse) \
+            if args.adaptive_frames else None
+    except (AssertionError, RuntimeError) as e:
+        print(f"error: a bench run failed ({str(e).splitlines()[0][:200]})", file=sys.stderr)
+        return 1
+    write_doc(args.out, size=args.size, figs=figs, small=small, ghdl=(speed, frame), adaptive=adaptive)
     args.json.parent.mkdir(parents=True, exist_ok=True)
     frames = sum(len(r["frames"]) for r in reps.values())
+    measured_full = args.size == "352x288"
+    derived = small[2] if small else None
     args.json.write_text(json.dumps(dict(
-        # fps: the 352x288 sequential figure (what the thesis estimated), derived from the measurement below
-        fps=full["sequential_fps"], fps_modes=dict(sequential=full["sequential_fps"],
-                                                   overlapped=full["overlapped_fps_bound"]),
-        fps_measured={m: f["fps"] for m, f in figs.items()}, frames=frames, size=args.size, clocks=CLOCKS,
-        simulator=f"GHDL (mcode), simulated time, measured at {args.size} and derived for 352x288 linearly in "
-                  "pixels (docs/system.md)", measured=figs,
-        full_frame_derived=full), indent=2) + "\n")
-    print(json.dumps(dict(fps_modes={m: f["fps"] for m, f in figs.items()}, full_frame_derived=full)))
+        fps=figs["sequential"]["fps"], fps_modes={m: f["fps"] for m, f in figs.items()},
+        frames=frames, size=args.size, clocks=CLOCKS,
+        simulator=f"{figs['sequential'].get('simulator')}, simulated time, measured at {args.size}" +
+                  ("" if measured_full else " (not 352x288)"),
+        measured=figs, derived_from_small=derived, bit_exact=all(f["bit_exact"] for f in figs.values())),
+        indent=2) + "\n")
+    print(json.dumps(dict(fps_modes={m: f["fps"] for m, f in figs.items()}, size=args.size, simulator=sim)))
     return 0
 
 

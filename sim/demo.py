@@ -42,6 +42,12 @@ def gradient_picture(g: np.ndarray, mask: np.ndarray) -> np.ndarray:
     return out
 
 
+#: The complete front end's step: the fastest simulator here (Verilator on MyHDL's Verilog of the top if
+#: installed, else GHDL), a size and frame count that keep make demo under 5 minutes on 2 cores (docs/system.md).
+SYSTEM_SIZE = (96, 72)
+SYSTEM_FRAMES = 2
+SYSTEM_MODES = ["sequential", "overlapped"]
+
 TARGET = 300  # corners per frame, both runs
 K = 0.04
 
@@ -84,6 +90,23 @@ def run_harris(out: Path, frame: np.ndarray, blocks: tuple[int, int]) -> tuple[n
     return flags * mask, report
 
 
+def rig_view(scene: np.ndarray, side: str) -> np.ndarray:
+    """What the synthetic rig's ``side`` camera sees of ``scene`` (a rectified view): the scene through the
+    inverse of the rig's backward map (fixed-point iteration), so that the top, rectifying with the rig's
+    calibration (``rig:WxH``), gives the scene back row-aligned."""
+    from eyestereo.tools.rectify.synthetic_rig import rig_maps
+
+    h, w = scene.shape
+    m = rig_maps(w, h)
+    mx, my = m[f"{side}_x"].astype(np.float32), m[f"{side}_y"].astype(np.float32)
+    v, u = np.mgrid[0:h, 0:w].astype(np.float32)
+    px, py = u.copy(), v.copy()
+    for _ in range(20):  # p such that M(p) = (u, v)
+        px -= cv2.remap(mx, px, py, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE) - u
+        py -= cv2.remap(my, px, py, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE) - v
+    return cv2.remap(scene, px, py, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+
+
 def write_png(path: Path, img: np.ndarray) -> None:
     if not cv2.imwrite(str(path), img):
         raise OSError(f"cannot write {path}")
@@ -96,6 +119,9 @@ def main(argv=None) -> int:
     out: Path = args.out.resolve()
     out.mkdir(parents=True, exist_ok=True)
     steps = StepRunner(out / "logs", width=29)
+    from eyestereo.sim.bench_stereo_frontend import fastest_simulator
+
+    system_sim = fastest_simulator()
     frame = make_frame(f"file:{IMAGE}", WIDTH, HEIGHT)
     write_png(out / "input.png", frame.astype(np.uint8))
     rel = os.path.relpath(out)
@@ -133,16 +159,22 @@ def main(argv=None) -> int:
 
         img = cv2.imread(str(ROOT / "tests" / "data" / IMAGE), cv2.IMREAD_GRAYSCALE)
         lp, rp = out / "system_left.png", out / "system_right.png"
-        write_png(lp, img[100:196, 150:278])
-        write_png(rp, img[100:196, 156:284])
-        summary = main_system(lp, rp, out / "system", size=(48, 32), frames=2, modes=["overlapped"])
+        w, h = SYSTEM_SIZE
+        scenes = [cv2.resize(img[100:196, x0:x0 + 128], (w, h), interpolation=cv2.INTER_AREA) for x0 in (150, 156)]
+        write_png(lp, rig_view(scenes[0], "left"))
+        write_png(rp, rig_view(scenes[1], "right"))
+        w, h = SYSTEM_SIZE
+        summary = main_system(lp, rp, out / "system", size=SYSTEM_SIZE, frames=SYSTEM_FRAMES, modes=SYSTEM_MODES,
+                              sim=system_sim)
         (out / "system.json").write_text(json.dumps(summary, indent=2) + "\n")
-        return (f"48x32 cameras at 18/17.9 MHz, {summary['frames']['overlapped']} frames overlapped, "
-                f"{summary['fps']['overlapped']:.0f} fps (simulated), bit-exact: "
-                f"{'yes' if summary['bit_exact'] else 'no'} -> system/rectified.png")
+        mt = summary["matches_last_frame"]
+        return (f"{w}x{h} cameras at 18/17.9 MHz, " + ", ".join(
+            f"{summary['frames'][m]} frames {m} {summary['fps'][m]:.0f} fps" for m in SYSTEM_MODES) +
+            f" (simulated), {mt['matches']} matches, bit-exact: {'yes' if summary['bit_exact'] else 'no'} "
+            "-> system/rectified.png, system/matches.png")
 
     try:
-        steps.run("stereo front end (GHDL)", system_step)
+        steps.run(f"stereo front end ({'Verilator' if system_sim == 'verilator' else 'GHDL'})", system_step)
         steps.run("sobel (VHDL, GHDL)", sobel_step)
         steps.run("harris_mono, 1 threshold", harris_step((1, 1)))
         steps.run("harris_mono, 4x4 thresholds", harris_step((4, 4)))

@@ -119,6 +119,13 @@ def _tool_env(sim: str, backend: str | None = None):
             # installed, compiles it once (make setup installs it from Debian as root).
             if shutil.which("ccache"):
                 os.environ.setdefault("OBJCACHE", "ccache")
+            # The PyPI package's verilated.mk leaves CFG_CXXFLAGS_PCH_I empty: a design large enough to be
+            # split into several C++ files (the complete front end) then fails to compile ("Vtop__pch.h.fast:
+            # linker input file not found"). GCC's flag for the precompiled header, as a make command-line
+            # variable (MAKEFLAGS), overrides the empty one.
+            flags = os.environ.get("MAKEFLAGS", "")
+            if "CFG_CXXFLAGS_PCH_I" not in flags:
+                os.environ["MAKEFLAGS"] = (flags + " CFG_CXXFLAGS_PCH_I=-include").strip()
             os.environ["PATH"] = os.pathsep.join([str(root / "bin"), os.environ.get("PATH", "")])
         elif shutil.which("iverilog") is None:
             raise RuntimeError("Icarus Verilog not found: install it (Debian: apt-get install iverilog)")
@@ -141,14 +148,34 @@ def build_dir_of(block: str, name: str, sim: str | None = None, build_root: Path
     return Path(build_root) / slug(block) / (slug(name) + tag)
 
 
+def _lean_verilator(build_dir: Path, top: str, public: list[str]):
+    """cocotb's Verilator runner without ``--public-flat-rw`` (every signal public, which keeps Verilator
+    from optimising any of them away), and the control file that makes only the signals matching
+    ``public`` (globs, e.g. the ports and the probes a bench reads) public: (runner, control file)."""
+    from cocotb_tools.runner import Verilator
+
+    vlt = Path(build_dir) / "public.vlt"
+    vlt.write_text("`verilator_config\n" + "".join(f'public_flat_rw -module "{top}" -var "{p}"\n' for p in public))
+
+    class _Lean(Verilator):
+        def _build_command(self):
+            cmds = super()._build_command()
+            cmds[0] = [c for c in cmds[0] if c != "--public-flat-rw"]
+            return cmds
+
+    return _Lean(), vlt
+
+
 def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict | None = None,
               waves: bool | None = None, build_root: Path = BUILD, log_file: Path | None = None,
-              sim: str | None = None, backend: str | None = None) -> dict:
+              sim: str | None = None, backend: str | None = None, public: list[str] | None = None) -> dict:
     """Convert ``block`` with ``params``, simulate it with cocotb module ``eyestereo.sim.<bench>``.
 
     ``sim``: ghdl (the VHDL), icarus or verilator (the Verilog conversion); default ``$SIM`` or ghdl.
     ``backend``: GHDL's back end, mcode or llvm (default ``$GHDL_BACKEND`` or mcode; see
-    :func:`fastest_ghdl_backend`). ``log_file``: the simulator's output goes there instead of to stdout
+    :func:`fastest_ghdl_backend`). ``public`` (Verilator only): globs of the signals the bench touches
+    (ports, probes); only these are made public instead of every signal (faster simulation; a bench
+    touching another signal fails). ``log_file``: the simulator's output goes there instead of to stdout
     (the build's to the same name with ``.build.log``; for commands that show their own progress).
     ``config`` is handed to the bench as JSON (environment variable ``EYESTEREO_TB``, with ``sim`` added);
     the bench may write a JSON report to ``report.json`` in the build folder, which is returned with
@@ -207,7 +234,11 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
             # 1ns/1ps as the runner's timescale: as Verilog-2005 (ICARUS_ARGS) the file's own timescale
             # sets Icarus's precision, and MyHDL's 10 ps cannot hold the camera benches' clock periods.
             sources = convert(block, build_dir, hdl="Verilog", timescale="1ns/1ps", **params)
-            runner = get_runner(sim)
+            if sim == "verilator" and public:
+                runner, vlt = _lean_verilator(build_dir, block, public)
+                sources = list(sources) + [vlt]
+            else:
+                runner = get_runner(sim)
             kw = dict(build_args=VERILATOR_ARGS if sim == "verilator" else ICARUS_ARGS)
             runner.build(sources=[str(s) for s in sources], hdl_toplevel=block, build_dir=build_dir,
                          always=True, waves=waves, timescale=("1ns", "1ps"), **kw, **logs)

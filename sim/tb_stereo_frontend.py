@@ -19,11 +19,13 @@ each stage (capture, rectification, lists complete, host read-out) and the arbit
 
 from __future__ import annotations
 
+import time
+
 import cocotb
 import numpy as np
 from cocotb.clock import Clock
 from cocotb.simtime import get_sim_time
-from cocotb.triggers import ClockCycles, Edge
+from cocotb.triggers import ClockCycles, Edge, Timer
 
 from eyestereo.sim.axil import AxiLiteHost
 from eyestereo.sim.bench import load_config, write_report
@@ -137,21 +139,28 @@ async def frames_bit_exact(dut):
             await Edge(sig)
             events.append((label, int(sig.value), get_sim_time(unit="ns")))
 
-    def probe(pattern):
-        # MyHDL numbers instances per process (rectifier0, rectifier1, ...): try the first few
-        for i in range(8):
-            for j in range(8):
-                try:
-                    return getattr(dut, pattern.format(i=i, j=j))
-                except AttributeError:
-                    pass
+    def probe(*patterns):
+        # MyHDL numbers instances per process and per level (rectifier0, rectifier0_0, ...; the naming differs
+        # with the configuration): try the first few of each form
+        for pattern in patterns:
+            for i in range(4):
+                for j in range(4):
+                    try:
+                        return getattr(dut, pattern.format(i=i, j=j))
+                    except AttributeError:
+                        pass
         return None
 
-    for pattern, label in (("rectifier{i}_busy", "rect_busy"), ("frontend_sequencer{i}_list_done", "list_done"),
-                           ("sram_subsystem{i}_sram_arbiter{j}_ctl_cam_held", "cam_held")):
-        sig = probe(pattern)
+    for patterns, label in ((("rectifier{i}_busy", "rectifier{i}_{j}_busy"), "rect_busy"),
+                            (("frontend_sequencer{i}_list_done", "frontend_sequencer{i}_{j}_list_done"), "list_done"),
+                            (("sram_subsystem{i}_sram_arbiter{j}_ctl_cam_held",
+                              "sram_subsystem{i}_{j}_sram_arbiter{i}_{j}_ctl_cam_held",
+                              "sram_subsystem{i}_0_sram_arbiter{j}_0_ctl_cam_held"), "cam_held")):
+        sig = probe(*patterns)
         if sig is not None:
             cocotb.start_soon(watch(sig, label))
+        else:
+            dut._log.warning(f"no probe for {label}: its stage time is left out")
 
     expected = {}  # (i, j, thresholds) -> model outputs, computed on demand
     cur = ([thr] * 16, [thr] * 16)  # the thresholds the system runs with
@@ -177,15 +186,30 @@ async def frames_bit_exact(dut):
         hits = [p for p in hits if p > last] or hits
         return hits[0]
 
+    if cfg.get("speed_us"):  # a speed measurement only: the system capturing, no comparison
+        await drv.start()
+        if cfg.get("speed_skip_us"):  # past the cameras' first VSYNC and back porch: into the active lines
+            await Timer(int(cfg["speed_skip_us"]), unit="us")
+        t0, w0 = get_sim_time(unit="ns"), time.time()
+        await Timer(int(cfg["speed_us"]), unit="us")
+        wall = time.time() - w0
+        sim_us = (get_sim_time(unit="ns") - t0) / 1e3
+        write_report(cfg, dict(mode=mode, width=w, height=h, speed=True, sim_us=sim_us, wall_s=round(wall, 2),
+                               memory_clocks_per_s=round(sim_us * 100 / wall, 1)))
+        return
     results, last_rect, last_list = [], (-1, -1), (-1, -1)
+    # a frame: up to two camera frames to the pair held, the rectification, the host's read-out before it
+    # (memory clocks; the camera's frame period in PCLK of 1/18 us, the memory clock 100 MHz)
+    timeout = max(5_000_000, int(6 * timing.frame_pclk * 100 / 17.9) + 40 * w * h)
     t_start = get_sim_time(unit="ns")
+    wall0 = time.time()
     if mode == "overlapped":
         await drv.start()
     for n in range(n_host):
         t0 = get_sim_time(unit="ns")
         if mode == "sequential":
             await drv.start()
-        await drv.wait_frame(after=n, timeout_clocks=5_000_000, poll_clocks=200)
+        await drv.wait_frame(after=n, timeout_clocks=timeout, poll_clocks=200)
         t_frame = get_sim_time(unit="ns")
         await drv.set(rect_want=1, feat_want=1)
         for _ in range(2000):
@@ -208,6 +232,8 @@ async def frames_bit_exact(dut):
             if a == 0xFFFF or i >= amap.feature_words:
                 break
         t_read = get_sim_time(unit="ns")
+        dut._log.info(f"frame {n}: started {t0 / 1e6:.3f} ms, done {t_frame / 1e6:.3f} ms, read {t_read / 1e6:.3f} ms "
+                      f"(simulated), wall {time.time() - wall0:.1f} s")
         await drv.pulse("rect_release", "feat_release")
         pr = find(lambda m: np.array_equal(m["rect_words"], rect), last_rect,
                   lambda m: (int(np.sum(m["rect_words"] != rect)), np.argwhere(m["rect_words"] != rect)[:4].tolist()))
@@ -230,10 +256,11 @@ async def frames_bit_exact(dut):
             await drv.configure(mode=mode, thresholds_left=cur[0], thresholds_right=cur[1])
     if mode == "overlapped":
         await drv.stop()
-    for _ in range(1000):
+    # stop ends continuous operation after the frame in progress: up to a camera frame and its rectification
+    for _ in range(max(1000, timeout // 1000)):
         if not (await drv.status())["busy"]:
             break
-        await bus.wait(100)
+        await bus.wait(100 if w * h < 10_000 else 1000)
     else:
         raise AssertionError("the system stays busy after stop")
     st = await drv.status()
@@ -274,4 +301,4 @@ def stage_times(events, starts) -> dict:
         return round(sum(v) / len(v) / 1e3, 2) if v else None
 
     return dict(capture_us=mean(capture), rectify_us=mean(rect), lists_after_rectifier_us=mean(lists),
-                rectified_frames=len(rect))
+                rectified_frames=len(rect), list_done_ns=ld, rect_start_ns=rb)

@@ -34,18 +34,23 @@ def test_sim_system_runs_the_front_end(capfd, tmp_path, pair):
     lp, rp = pair
     out, js = tmp_path / "out", tmp_path / "fig.json"
     code, so, se = run(capfd, "sim", "system", lp, rp, "-o", out, "--json", js, "--size", "32x24",
-                       "--frames", "1", "--modes", "overlapped")
+                       "--frames", "1", "--modes", "overlapped", "--sim", "ghdl")
     assert code == 0, se
-    assert sorted(p.name for p in out.iterdir()) == ["rectified.png", "summary.json"]
+    assert sorted(p.name for p in out.iterdir()) == ["matches.png", "rectified.png", "summary.json"]
     fig = json.loads(js.read_text())
     assert fig == json.loads((out / "summary.json").read_text())
     assert fig["bit_exact"] is True and fig["frames"] == {"overlapped": 1} and fig["fps"]["overlapped"] > 0
     assert set(fig["sram_share"]["overlapped"]) == {"cam0", "cam1", "fetch", "rect", "feat", "host"}
     assert cv2.imread(str(out / "rectified.png")) is not None
+    m = fig["matches_last_frame"]
+    assert sum(m["corners"]) == fig["features_last_frame"] and 0 <= m["matches"] <= min(m["corners"])
+    assert fig["simulator"].startswith("GHDL")
+    pic = cv2.imread(str(out / "matches.png"))
+    assert pic is not None and pic.shape[1] == 32 * (480 // 32)
     assert "bit-exact: yes" in so
 
 
-@pytest.mark.parametrize("case", ["missing", "modes", "size", "frames", "parent"])
+@pytest.mark.parametrize("case", ["missing", "modes", "size", "frames", "parent", "sim"])
 def test_sim_system_bad_input(capfd, tmp_path, pair, case):
     lp, rp = pair
     out = tmp_path / "out"
@@ -58,8 +63,28 @@ def test_sim_system_bad_input(capfd, tmp_path, pair, case):
         argv += ["--size", "7x3"]
     elif case == "frames":
         argv += ["--frames", "0"]
+    elif case == "sim":
+        argv += ["--sim", "modelsim"]
     else:
         argv[-1] = tmp_path / "no" / "out"
     code, so, se = run(capfd, *argv)
     assert code != 0 and "error" in se.lower() and len(se.strip().splitlines()) <= 2, se
     assert not out.exists() and not (tmp_path / "no").exists()
+
+
+def test_matches_picture_colours_the_known_disparity(tmp_path):
+    """The matched-features picture on a pair with a known shift: every corner found again at d = 5."""
+    import numpy as np
+
+    from eyestereo.sim.cli_system import _matches_picture
+
+    rng = np.random.default_rng(3)
+    big = rng.integers(0, 256, (48, 80))
+    left, right = big[:, 8:72], big[:, 13:77]  # right(x - 5) = left(x): disparity 5 everywhere
+    rect = left.astype(np.int64) | right.astype(np.int64) << 8
+    pts = [(20, 10), (30, 20), (40, 30), (25, 36), (45, 15)]
+    feats = [(x, y, 0) for x, y in pts] + [(x - 5, y, 1) for x, y in pts]
+    m = _matches_picture(rect, feats, tmp_path / "m.png")
+    assert m == dict(corners=[5, 5], matches=5, disparity=[5, 5])
+    assert cv2.imread(str(tmp_path / "m.png")) is not None
+    assert _matches_picture(rect, [], tmp_path / "e.png") == dict(corners=[0, 0], matches=0, disparity=None)
