@@ -18,7 +18,7 @@ from eyestereo.tools.models import stereo_frontend as model
 
 SPEC = "rig:32x24"
 W, H = 32, 24
-FRAMES = {"sequential": 3, "overlapped": 3}
+FRAMES = {"sequential": 2, "overlapped": 3}  # sequential frames cost a camera frame each (VSYNC waits)
 TIMING = dict(h_blank=8, v_sync=1, v_back=1, v_front=1)
 
 
@@ -39,7 +39,7 @@ def test_stereo_frontend(request, mode):
     assert rep["frames_done"] >= n
     if mode == "sequential":  # the thresholds the host wrote frame by frame took effect (bit-exact with them)
         thr = [f["thresholds"] for f in rep["frames"]]
-        assert thr[1] != thr[0] and thr[2] != thr[1]
+        assert all(b != a for a, b in zip(thr, thr[1:]))
     moved = {w: rep["arb"][w] for w in rep["arb"] if w.startswith("moved_")}
     assert moved["moved_rect"] >= n * W * H and moved["moved_fetch"] > 0 and moved["moved_feat"] > 0
 
