@@ -104,15 +104,17 @@ def box(world, tmp_path):
 
 
 def test_calibrate_refuses_one_camera_given_twice(capfd, box):
-    refused(capfd, box, 1, ["identical (left01.png / left01.png)", "give each camera's own images"],
+    line = refused(capfd, box, 1, ["identical (left01.png / left01.png)", "give each camera's own images"],
             "calibrate", box / "rig" / "left*.png", box / "rig" / "left*.png", "--square", "0.02", "-o",
             box / "out.yml")
+    assert line.startswith("eyestereo: error: ")
 
 
 def test_calibrate_refuses_swapped_cameras(capfd, box):
-    refused(capfd, box, 1, ["left camera is to the right of the right camera", "give the left camera's images first"],
+    line = refused(capfd, box, 1, ["left camera is to the right of the right camera", "give the left camera's images first"],
             "calibrate", box / "rig" / "right*.png", box / "rig" / "left*.png", "--square", "0.02", "-o",
             box / "out.yml")
+    assert line.startswith("eyestereo: error: ")
 
 
 def test_calibrate_refuses_stacked_cameras(capfd, box):
@@ -120,16 +122,18 @@ def test_calibrate_refuses_stacked_cameras(capfd, box):
     rot.mkdir()
     for p in (box / "rig").glob("*.png"):
         cv2.imwrite(str(rot / p.name), cv2.rotate(cv2.imread(str(p), cv2.IMREAD_GRAYSCALE), cv2.ROTATE_90_CLOCKWISE))
-    refused(capfd, box, 1, ["the right camera sits below the left one", "rotate every image by 90 degrees"],
+    line = refused(capfd, box, 1, ["the right camera sits below the left one", "rotate every image by 90 degrees"],
             "calibrate", rot / "left*.png", rot / "right*.png", "--square", "0.02", "-o", box / "out.yml")
+    assert line.startswith("eyestereo: error: ")
 
 
 @pytest.mark.skipif(not REAL.is_dir(), reason=f"shared calibration images not found at {REAL}")
 def test_calibrate_refuses_a_lens_model_from_too_few_views(capfd, tmp_path):
     """Three of OpenCV's pairs: OpenCV calibrates them, but the right lens model folds inside the image."""
-    refused(capfd, tmp_path, 1, ["calibration refused: the right camera's lens model (M2, D2) folds back",
+    line = refused(capfd, tmp_path, 1, ["calibration refused: the right camera's lens model (M2, D2) folds back",
                                  "% of the right image", "with the board also near the corners and edges"],
             "calibrate", REAL / "left0[1-3].jpg", REAL / "right0[1-3].jpg", "-o", tmp_path / "c.yml")
+    assert line.startswith("eyestereo: error: ")
 
 
 @pytest.mark.parametrize("change, pieces", [

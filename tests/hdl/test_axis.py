@@ -134,7 +134,8 @@ def test_stream_to_axis_overflow_under_random_back_pressure(request):
 @pytest.mark.sim
 @pytest.mark.parametrize("pause,data_width", [(0.0, 8), (0.4, 8), (0.8, 12)])
 def test_axis_to_stream_exact_with_pauses(request, pause, data_width):
-    _a2s(request, dict(SMALL, data_width=data_width), dict(frames=FRAMES, pause=pause, seed=3))
+    rep = _a2s(request, dict(SMALL, data_width=data_width), dict(frames=FRAMES, pause=pause, seed=3))
+    assert rep["frames"] == len(FRAMES) and rep["tokens"] == 0 and rep["errors"] == 0, rep
 
 
 @pytest.mark.sim
@@ -149,5 +150,6 @@ def test_axis_to_stream_faults_become_tokens(request):
 
 @pytest.mark.sim
 def test_axis_to_stream_tiny_frames(request):
-    _a2s(request, dict(width=1, height=1), dict(frames=["random:1", "random:2", "random:3"], pause=0.5, seed=5,
-                                                faults=[[1, "junk"]]))
+    rep = _a2s(request, dict(width=1, height=1), dict(frames=["random:1", "random:2", "random:3"], pause=0.5,
+                                                      seed=5, faults=[[1, "junk"]]))
+    assert rep["frames"] >= 2 and rep["pixels_compared"] == rep["frames"], rep

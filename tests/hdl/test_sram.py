@@ -34,8 +34,9 @@ def test_controller_random(request, kind, lat):
 @pytest.mark.parametrize("seed", [11, 12])
 def test_controller_back_to_back(request, kind, seed):
     """Commands every clock, write share 0.3 and 0.7: the densest read/write mixes."""
-    _ctrl(request, dict(kind=kind, read_latency=2), dict(seed=seed, commands=400, duty=1.0,
-                                                           write_share=0.3 if seed % 2 else 0.7))
+    rep = _ctrl(request, dict(kind=kind, read_latency=2), dict(seed=seed, commands=400, duty=1.0,
+                                                                 write_share=0.3 if seed % 2 else 0.7))
+    assert rep["reads"] > 50 and rep["writes"] > 50, rep
 
 
 # The Verilog conversion: on Icarus in make test, on Verilator in make test-sims (marker othersims).
@@ -95,7 +96,8 @@ def test_subsystem_random_traffic(request, kind, seed):
 
 @pytest.mark.parametrize("kind,lat", [("nobl", 1), ("pipelined", 3)])
 def test_subsystem_read_latency(request, kind, lat):
-    _sub(request, dict(kind=kind, read_latency=lat), dict(seed=3, clocks=4000))
+    rep = _sub(request, dict(kind=kind, read_latency=lat), dict(seed=3, clocks=4000))
+    assert rep["fetch_reads"] > 0, rep
 
 
 @pytest.mark.parametrize("kind", ["nobl", "pipelined"])
