@@ -24,7 +24,7 @@ from cocotb.triggers import First, RisingEdge, Timer
 from cocotb.utils import get_sim_time
 
 from eyestereo.hdl.convert import vhdl_ports
-from eyestereo.sim.stream import UNKNOWN, IdleGenerator
+from eyestereo.sim.stream import UNKNOWN, IdleGenerator, SinkResults
 from eyestereo.tools.stream import TOKEN, FrameAssembler, ProtocolError, frame_to_beats
 
 STIM, SENT, CAPT = "hb_stim.txt", "hb_sent.txt", "hb_capt.txt"
@@ -235,7 +235,7 @@ class HdlStreamSource:
         self.sent_cycles = [self.time.cycle(int(t)) for t in Path(SENT).read_text().split()]
 
 
-class HdlStreamSink:
+class HdlStreamSink(SinkResults):
     """The recorder's side: the same frame bookkeeping and checks as StreamSink, on the recorded beats."""
 
     def __init__(self, dut, clk, width: int, height: int):
@@ -259,17 +259,6 @@ class HdlStreamSink:
     def cycle(self) -> int:
         return self.time.cycle()
 
-    @property
-    def frames(self):
-        return self.asm.frames
-
-    @property
-    def events(self):
-        return self.asm.events
-
-    def check(self) -> None:
-        if self.error is not None:
-            raise self.error
 
     def _fail(self, msg: str) -> None:
         if self.error is None:

@@ -169,7 +169,28 @@ class StreamSource:
             await fall
 
 
-class StreamSink:
+class SinkResults:
+    """What every stream sink gives its bench: the frames and events it assembled (``asm``, a
+    FrameAssembler) and the first protocol error it saw (``error``), raised by :meth:`check`."""
+
+    asm: FrameAssembler
+    error: ProtocolError | None
+
+    @property
+    def frames(self):
+        return self.asm.frames
+
+    @property
+    def events(self):
+        return self.asm.events
+
+    def check(self) -> None:
+        """Raise the first protocol error seen, if any."""
+        if self.error is not None:
+            raise self.error
+
+
+class StreamSink(SinkResults):
     """Monitors ``<prefix>_*`` and rebuilds frames; any protocol fault is recorded and re-raised.
 
     ``received_cycles`` holds the cycle number of every beat, counted like the source's: a beat the
@@ -202,18 +223,6 @@ class StreamSink:
         """Rising edges since the sink started."""
         return self.time.cycle()
 
-    @property
-    def frames(self):
-        return self.asm.frames
-
-    @property
-    def events(self):
-        return self.asm.events
-
-    def check(self) -> None:
-        """Raise the first protocol error seen, if any."""
-        if self.error is not None:
-            raise self.error
 
     def _fail(self, msg: str) -> None:
         if self.error is None:
@@ -306,7 +315,7 @@ class ClockedStreamSource:
                 self.valid.value = 0
 
 
-class ClockedStreamSink:
+class ClockedStreamSink(SinkResults):
     """The cycle-by-cycle sink the benches used before :class:`StreamSink` (RisingEdge + ReadOnly per clock).
 
     Kept so ``make bench`` can measure both in one run (bench config ``drivers="clocked"``).
@@ -330,18 +339,6 @@ class ClockedStreamSink:
         self.active = False  # set once the DUT is out of reset: before that its outputs are undefined
         self._task = cocotb.start_soon(self._run())
 
-    @property
-    def frames(self):
-        return self.asm.frames
-
-    @property
-    def events(self):
-        return self.asm.events
-
-    def check(self) -> None:
-        """Raise the first protocol error seen, if any."""
-        if self.error is not None:
-            raise self.error
 
     async def _run(self):
         while True:
