@@ -10,7 +10,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-$(shell (cat pyproject.toml 2>/dev/null || echo none) | cksum | cut -d' ' -f1)
 JOBS   ?= 2
 
-.PHONY: all setup ghdl ccache simulator vhdl verilog sim test test-sims demo synth timing regs report bench clean distclean help
+.PHONY: all setup ghdl ccache simulator vhdl verilog sim test test-sims test-time demo synth timing regs report bench clean distclean help
 
 all: test
 
@@ -97,6 +97,10 @@ test-sims: setup
 # scheduler one core sat idle for the last 7 minutes of a 2-worker run while the other ran the SRAM benches).
 test: setup
 	$(PY) -m pytest -n $(JOBS) --dist worksteal --durations=25
+
+# make test timed (wall and CPU time, slowest tests) into docs/suite.md; measure on a quiet machine
+test-time: setup
+	$(PY) -m eyestereo.sim.suite_time --out docs/suite.md --jobs $(JOBS)
 
 demo: setup
 	$(PY) -m eyestereo.sim.demo --out build/demo

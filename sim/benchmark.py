@@ -69,50 +69,50 @@ CASES = [
 #: simulator columns: name -> (SIM, GHDL_BACKEND)
 SIMULATORS = {"ghdl-mcode": ("ghdl", "mcode"), "ghdl-llvm": ("ghdl", "llvm"),
               "ghdl-llvm-hdl": ("ghdl", "llvm"), "ghdl-llvm-net": ("ghdl", "llvm"),
-              "ghdl-llvm-net-hdl": ("ghdl", "llvm"), "icarus": ("icarus", None),
+              "ghdl-llvm-net-hdl": ("ghdl", "llvm"), "ghdl-llvm-hdl-fast": ("ghdl", "llvm"), "icarus": ("icarus", None),
               "verilator": ("verilator", None)}
 #: columns whose benches run with other stream drivers than the event-driven Python ones
-DRIVERS = {"ghdl-llvm-hdl": "hdl", "ghdl-llvm-net-hdl": "hdl"}
+DRIVERS = {"ghdl-llvm-hdl": "hdl", "ghdl-llvm-net-hdl": "hdl", "ghdl-llvm-hdl-fast": "hdl"}
+#: columns on GHDL with the faster numeric_std body (sim/ghdl_ieee.py)
+IEEE = {"ghdl-llvm-hdl-fast": "fast"}
 #: columns that simulate GHDL's synthesized VHDL netlist of the block instead of its VHDL (runner design=)
 DESIGNS = {"ghdl-llvm-net": "netlist", "ghdl-llvm-net-hdl": "netlist"}
 #: measured for issue 9 (see the notes), slower than the VHDL: only with --sims
 OPT_IN = ("ghdl-llvm-net", "ghdl-llvm-net-hdl")
 LABELS = {"ghdl-llvm-hdl": "ghdl-llvm, HDL drivers", "ghdl-llvm-net": "ghdl-llvm, netlist",
-          "ghdl-llvm-net-hdl": "ghdl-llvm, netlist, HDL drivers"}
+          "ghdl-llvm-net-hdl": "ghdl-llvm, netlist, HDL drivers",
+          "ghdl-llvm-hdl-fast": "ghdl-llvm, HDL drivers, fast numeric_std"}
 BEFORE = "ghdl-mcode, per-clock drivers"
 RESULTS = BUILD.parent / "bench_sims.json"
 
 NOTES = """
-* Issue 9 asked for the harris_mono bench 3x faster on GHDL than before; 'fastest GHDL vs before'
-  says what this run reached against the per-clock mcode bench measured next to it (about 2.3x, by
-  simulation time and by CPU time alike: LLVM with the HDL drivers). The 3x is not reached, for the
-  reason below.
-* Where GHDL's time goes (harris_mono, `perf` on this machine): in the LLVM-compiled simulation of the
-  bench about 70 % of the samples are in GHDL's compiled design and IEEE libraries, about 13 % in
-  Python. Of the compiled part, numeric_std does the arithmetic bit by bit in VHDL (`"*"` is a loop of
-  `"+"`, each a `TO_01` and a bit-serial add of `and`/`or`/`xor` calls: `TO_01` alone 13 %, the
-  std_logic gates 12 %), and updating the std_logic signals bit by bit 15 % (a VHDL-only testbench of
-  harris_mono without cocotb, random pixels: 3900 clocks per CPU second on LLVM -O2, 1900 on mcode).
-  So the back end is what counts: LLVM about doubles mcode; -O3 is no faster than -O2, `--std=93c`
-  no faster than 08, Debian's `ghdl-gcc` slower than LLVM (12.8 against 7.7 CPU s for 30000 clocks of
-  that testbench); `--ieee-asserts=disable` is on for every GHDL run. Taking Python out of the loop
-  altogether (the HDL drivers column) gains only what Python cost. More would need the VHDL itself to
-  do less per clock (numeric_std arithmetic on 36-bit words is most of it), which is the product and
-  was left alone.
-* Also measured for the 3x (harris_mono 4x4, one run, load 2.1 to 3.5; simulation-only / CPU clocks/s):
-  per-clock mcode bench 2109 / 2198, LLVM with HDL drivers 5221 / 5291 (2.48x / 2.41x), and GHDL's own
-  synthesized netlist of the same VHDL (`ghdl synth --out=vhdl`, runner option `design="netlist"`,
-  columns `--sims ghdl-llvm-net,ghdl-llvm-net-hdl`) on LLVM: 2715 / 2736 with the Python drivers, 2904 /
-  2947 with the HDL drivers, bit-exact with the model and the VHDL on both frames, but about half the
-  VHDL's speed: the netlist turns every intermediate value into a signal (1400 signals and 800
-  concurrent assignments against 381 signals, each its own process and delta cycle) and keeps
-  numeric_std's `"*"`. Debian's LLVM IEEE libraries are already compiled with -O2 (numeric_std-body.o
-  has the text size of a -O2 build, half of -O0's; -O3 is 2 % larger); cocotb's runner passes
-  build_args to both analysis and elaboration, so `-O2` reaches the design too. Of GHDL 2.0's run-time
-  options (`--ieee-asserts=disable` is on) only `--activity=none` (GHDL calls it unsafe: no 'active
-  bookkeeping) and `--asserts=disable` do less work: 5979, 6246, 6398 clocks/s (LLVM, HDL drivers,
-  one later run), +4 % and +2 %, within the noise of this machine and not adopted. cocotb registers
-  value-change callbacks only for what a bench awaits: with the HDL drivers a few signals per frame.
+* Issue 9 asked for the harris_mono full-frame bench 3x faster on GHDL than it was. 'ghdl-mcode, bench of
+  958a558' is that bench itself: the tree of commit 958a558 (the last before the issue; `git archive`
+  into build/before/, its own runner, drivers and model) run in the same `make bench` as the other
+  columns; 'fastest GHDL vs before' and 'fastest vs before' divide by its simulation-only rate (it
+  reports no CPU time). Where it did not run, they divide by 'ghdl-mcode, per-clock drivers' (today's
+  design and bench with the per-clock stream drivers of before), which is the slower of the two.
+* What made GHDL faster, in order: the LLVM back end (about 2x mcode: Debian's `ghdl-llvm`,
+  `GHDL_BACKEND=llvm`), the VHDL player and recorder (`drivers="hdl"`, sim/hdl_drivers.py: Python wakes
+  once per output frame instead of every clock), and a faster numeric_std for simulation
+  ('fast numeric_std', `ieee="fast"` or `GHDL_IEEE=fast`, sim/ghdl_ieee.py). `perf` showed the
+  LLVM-compiled bench spending most of its time in numeric_std, which GHDL runs from its VHDL source:
+  an N-bit `"+"` is N iterations of eight std_logic `and`/`or`/`xor` calls, an N x M `"*"` is N such
+  additions, each with its own `TO_01` and `RESIZE` (the cornerness pipeline's four 17x17 products were a
+  fifth of all samples). The fast library is GHDL's own ieee2008 sources with four functions of the
+  numeric_std body given a fast path (additions with an integer carry, products from column sums),
+  taken only when every operand bit is '0' or '1', so metavalues propagate exactly as before; the
+  package declarations are untouched, so the design is the same. `tests/hdl/test_ghdl_ieee.py` compares
+  it with the standard library (and with Python's integers) on 2,100 operand pairs up to 45 x 45 bits,
+  metavalues included; every bench run on it checks its output bit for bit against the model, and the
+  'equal' column compares its words with every other simulator's. The standard library stays the
+  default: the product's benches run on IEEE's numeric_std.
+* Tried and not adopted (harris_mono 4x4, earlier runs): GHDL's own synthesized netlist of the VHDL
+  (`ghdl synth --out=vhdl`, runner option `design="netlist"`, columns `--sims ghdl-llvm-net,ghdl-llvm-net-hdl`):
+  bit-exact, but about half the VHDL's speed (1400 signals and 800 concurrent assignments against 381
+  signals). -O3 (no faster than -O2, which Debian's libraries and the runner already use),
+  `--std=93c` (no faster than 08), Debian's `ghdl-gcc` (slower than LLVM), `--activity=none` (+4 %,
+  GHDL calls it unsafe) and `--asserts=disable` (+2 %), both within this machine's noise.
 * On Verilator the design is cheap and Python's wake-ups are most of a bench's time: the stream
   drivers wake once per beat (source and sink, at the falling edge mid-cycle) and sleep across idle
   stretches and while the output is idle.
@@ -164,7 +164,7 @@ def run_case(case, sim_name: str, *, drivers: str = "events") -> dict:
     sim, backend = SIMULATORS[sim_name]
     design = DESIGNS.get(sim_name, "vhdl")
     run_name = (f"bench_{slug(name)}" + ("" if drivers == "events" else f"_{drivers}")
-                + ("" if design == "vhdl" else f"_{design}"))
+                + ("" if design == "vhdl" else f"_{design}") + ("_fast" if sim_name in IEEE else ""))
     saved = os.environ.get("GHDL_BACKEND")
     if backend:
         os.environ["GHDL_BACKEND"] = backend
@@ -173,7 +173,8 @@ def run_case(case, sim_name: str, *, drivers: str = "events") -> dict:
         dump = out_dir.parent / f"{out_dir.name}.frames.npy"
         t0 = time.perf_counter()
         rep = run_bench(block, bench, dict(extra, frames=frames, duty=1.0, timing=True, drivers=drivers,
-                                           design=design, dump=str(dump)), name=run_name, params=params, sim=sim)
+                                           design=design, ieee=IEEE.get(sim_name, "standard"), dump=str(dump)),
+                       name=run_name, params=params, sim=sim)
         wall = time.perf_counter() - t0
     finally:
         if saved is None:
@@ -194,8 +195,69 @@ def run_case(case, sim_name: str, *, drivers: str = "events") -> dict:
     return dict(name=name, block=block, sim=sim_name, drivers=drivers, ppc=float(ppc), lat_min=int(lat.min()),
                 lat_max=int(lat.max()), lead_lines=radius, lead_pixels=radius, cycles=rep["cycles"], wall=wall,
                 sim_s=rep.get("sim_seconds"), cpu_s=rep.get("cpu_seconds"), compared=rep["pixels_compared"],
-                dump=str(dump),
+                dump=str(dump), date=str(datetime.date.today()),
                 load=os.getloadavg()[0])
+
+
+#: the bench as it stood when issue 9 asked for 3x (its harris_mono bench ran about 2.5 k clocks/s)
+BEFORE_COMMIT = "958a558"
+
+# Runs in the old tree (its own eyestereo package first on PYTHONPATH): its run_bench, its bench, its model.
+_BEFORE_SCRIPT = """
+import json, sys, time, xml.etree.ElementTree as ET
+from pathlib import Path
+from eyestereo.sim.runner import run_bench
+case = json.loads(sys.argv[1])
+root = Path(sys.argv[2])
+t0 = time.perf_counter()
+rep = run_bench(case["block"], case["bench"], case["config"], name="bench_before", params=case["params"],
+                build_root=root)
+wall = time.perf_counter() - t0
+res = root / case["block"] / "bench_before" / "results.xml"
+tc = next(ET.parse(res).iter("testcase"))
+props = {p.get("name"): p.get("value") for p in tc.iter("property")}
+print(json.dumps(dict(frames=rep.get("frames"), compared=rep.get("pixels_compared"), wall=wall,
+                      sim_s=float(tc.get("time")), sim_ns=float(props["sim_time_duration"]))))
+"""
+
+
+def run_before_commit(case, rev: str = BEFORE_COMMIT) -> dict:
+    """``case``'s bench as it was at commit ``rev`` (GHDL mcode, its own runner, drivers and model).
+
+    The tree of ``rev`` is unpacked under ``build/before/<rev>`` (``git archive``; needs the repository's
+    history), its package put first on PYTHONPATH, and its bench timed like the others (cocotb's time of
+    the test; clocks from the simulated time at its 10 ns clock).
+    """
+    import os
+    import shutil
+    import subprocess
+
+    name, block, bench, params, radius, frames = case[:6]
+    extra = case[6] if len(case) > 6 else {}
+    root = BUILD.parent / "before" / rev
+    if not (root / ".complete").exists():
+        shutil.rmtree(root, ignore_errors=True)
+        root.mkdir(parents=True)
+        tar = subprocess.run(["git", "-C", str(ROOT), "archive", rev], capture_output=True)
+        if tar.returncode != 0:
+            raise RuntimeError(f"git archive {rev}: {tar.stderr.decode().strip()} (the benchmark needs the history)")
+        subprocess.run(["tar", "-x", "-C", str(root)], input=tar.stdout, check=True)
+        pkg = root / "pkg" / "eyestereo"
+        pkg.mkdir(parents=True)
+        for d in ("hdl", "sim", "tools"):
+            (pkg / d).symlink_to(root / d)
+        (root / ".complete").touch()
+    spec = dict(block=block, bench=bench, params={k: (list(v) if isinstance(v, tuple) else v) for k, v in params.items()},
+                config=dict(extra, frames=frames, duty=1.0))
+    env = dict(os.environ, PYTHONPATH=str(root / "pkg"), GHDL_BACKEND="mcode")
+    r = subprocess.run([sys.executable, "-c", _BEFORE_SCRIPT, json.dumps(spec), str(root / "build" / "sim")],
+                       cwd=root, env=env, capture_output=True, text=True)
+    if r.returncode != 0:
+        raise RuntimeError(f"the bench of {rev} failed: {(r.stderr or r.stdout).strip().splitlines()[-1:]}")
+    got = json.loads(r.stdout.strip().splitlines()[-1])
+    return dict(name=name, block=block, sim="ghdl-mcode", drivers="commit", rev=rev, cycles=int(got["sim_ns"] // 10),
+                sim_s=got["sim_s"], wall=got["wall"], cpu_s=None, compared=got["compared"],
+                date=str(datetime.date.today()), load=os.getloadavg()[0])
 
 
 def measure(case) -> dict:
@@ -241,13 +303,13 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
     by = {(r["name"], r.get("sim", "ghdl-mcode"), r.get("drivers", "events")): r for r in results}
     names = list(dict.fromkeys([r["name"] for r in results] + [k[0] for k in failed]))
     for nm in names:
-        r = next((by[k] for k in by if k[0] == nm and k[2] != "clocked"), None)
+        r = next((by[k] for k in by if k[0] == nm and k[2] not in ("clocked", "commit")), None)
         if r is None:
             continue
         lat = str(r["lat_min"]) if r["lat_min"] == r["lat_max"] else f"{r['lat_min']}..{r['lat_max']}"
         n = r["lead_lines"]
         lead = f"{n} line{'s' if n > 1 else ''} + {n} px" if n else "-"
-        others = [o for k, o in by.items() if k[0] == nm and k[2] != "clocked"]
+        others = [o for k, o in by.items() if k[0] == nm and k[2] not in ("clocked", "commit")]
         same = all((o["ppc"], o["lat_min"], o["lat_max"], o["cycles"]) == (r["ppc"], r["lat_min"], r["lat_max"],
                                                                           r["cycles"]) for o in others)
         agree = f"yes ({len(others)})" if same and len(others) > 1 else ("-" if same else "**no**")
@@ -276,12 +338,18 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
             "same on every pixel of both frames (not only where the model specifies them).", ""]
     cols = list(sims)
     has_before = any(k[2] == "clocked" for k in by)
-    head = ([BEFORE] if has_before else []) + [LABELS.get(c, c) for c in cols]
+    has_commit = any(k[2] == "commit" for k in by)
+    head = ([f"ghdl-mcode, bench of {BEFORE_COMMIT}"] if has_commit else []) + ([BEFORE] if has_before else []) + \
+        [LABELS.get(c, c) for c in cols]
     out += ["| bench | " + " | ".join(head) + " | fastest GHDL vs before | fastest vs before | equal |",
             "|---|" + "---:|" * len(head) + "---:|---:|---|"]
     fails: list[tuple[str, str, str]] = []
     for nm in names:
         cells = []
+        commit = by.get((nm, "ghdl-mcode", "commit"))
+        if has_commit:
+            cells.append(f"{_rate(commit['cycles'], commit['sim_s'])} / {_rate(commit['cycles'], commit['wall'])} / ?"
+                         if commit else "-")
         before = by.get((nm, "ghdl-mcode", "clocked"))
         if has_before:
             cells.append(f"{_rate(before['cycles'], before['sim_s'])} / {_rate(before['cycles'], before['wall'])} / "
@@ -307,11 +375,14 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
                 if c.startswith("ghdl"):
                     ghdl_cpu = max(ghdl_cpu, r["cycles"] / r["cpu_s"])
         def vs(rate, cpu_rate):
-            if not (before and before["sim_s"] and rate):
+            # against the bench of BEFORE_COMMIT where it ran (simulation time only: it reports no CPU
+            # time), else against the per-clock drivers on today's design
+            ref = commit or before
+            if not (ref and ref["sim_s"] and rate):
                 return "-"
-            text = f"{rate / (before['cycles'] / before['sim_s']):.2f}x"
-            if before.get("cpu_s") and cpu_rate:
-                text += f" ({cpu_rate / (before['cycles'] / before['cpu_s']):.2f}x)"
+            text = f"{rate / (ref['cycles'] / ref['sim_s']):.2f}x"
+            if ref.get("cpu_s") and cpu_rate:
+                text += f" ({cpu_rate / (ref['cycles'] / ref['cpu_s']):.2f}x)"
             return text
 
         gain = vs(ghdl, ghdl_cpu) + " | " + vs(best, best_cpu)
@@ -330,9 +401,22 @@ def _load_note(results: list[dict]) -> str:
     loads = [r["load"] for r in results if r.get("load") is not None]
     if not loads:
         return ""
-    return (f"The machine ({os.cpu_count()} cores) was shared while measuring: 1-minute load average "
+    text = (f"The machine ({os.cpu_count()} cores) was shared while measuring: 1-minute load average "
             f"{min(loads):.1f} to {max(loads):.1f} at the end of the runs. Absolute speeds scale with the load; "
-            "the columns of one row were measured in the same run and compare with each other.")
+            "the columns of one row were measured in the same run and compare with each other")
+    # `--resume` keeps earlier results: say which rows mix runs (and so loads)
+    splits: dict[str, list[str]] = {}
+    for name in dict.fromkeys(r["name"] for r in results):
+        rows = [r for r in results if r["name"] == name]
+        days = sorted({r.get("date", "earlier") for r in rows})
+        if len(days) > 1:
+            cols = {d: sorted({LABELS.get(r["sim"], r["sim"]) for r in rows if r.get("date", "earlier") == d})
+                    for d in days}
+            splits.setdefault("; ".join(f"{d}: {', '.join(c)}" for d, c in cols.items()), []).append(name)
+    if splits:
+        text += (", except rows completed in a later run (`--resume`), each column with the load of its own "
+                 "run: " + "; ".join(f"{', '.join(names)} ({split})" for split, names in splits.items()))
+    return text + "."
 
 
 def _equal(name: str, results: list[dict]) -> str:
@@ -389,19 +473,21 @@ def main(argv=None) -> int:
     todo = [(c, s, DRIVERS.get(s, "events")) for c in cases for s in sims]
     if args.before and "ghdl-mcode" in sims:
         todo += [(c, "ghdl-mcode", "clocked") for c in cases if args.before == "all" or args.before in c[0]]
+        todo += [(c, "ghdl-mcode", "commit") for c in cases if args.before == "all" or args.before in c[0]]
     # The before/after comparison first: it is the one that needs every simulator of one bench.
     # The per-clock run right after the same bench's event-driven GHDL mcode run: the machine's load
     # changes least between the two.
-    order = {("ghdl-mcode", "events"): 0, ("ghdl-mcode", "clocked"): 1}
+    order = {("ghdl-mcode", "commit"): 0, ("ghdl-mcode", "events"): 1, ("ghdl-mcode", "clocked"): 2}
     todo.sort(key=lambda t: (0 if (args.before and args.before != "all" and args.before in t[0][0]) else 1,
                              CASES.index(t[0]), order.get((t[1], t[2]), 2)))
     RESULTS.parent.mkdir(parents=True, exist_ok=True)
     for case, sim, drivers in todo:
         if (case[0], sim, drivers) in have or args.report_only:
             continue
-        print(f"benchmark: {case[0]} on {sim}{' (per-clock drivers)' if drivers == 'clocked' else ''} ...", flush=True)
+        what = {"clocked": " (per-clock drivers)", "commit": f" (the bench of {BEFORE_COMMIT})"}.get(drivers, "")
+        print(f"benchmark: {case[0]} on {sim}{what} ...", flush=True)
         try:
-            done.append(run_case(case, sim, drivers=drivers))
+            done.append(run_before_commit(case) if drivers == "commit" else run_case(case, sim, drivers=drivers))
         except Exception as exc:  # noqa: BLE001 -- a bench that cannot run on a simulator is a result too
             why = " ".join(str(exc).split())[:300] or type(exc).__name__
             print(f"benchmark: {case[0]} on {sim} failed: {why}", flush=True)

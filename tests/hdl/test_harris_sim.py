@@ -102,12 +102,22 @@ THR_TSUKUBA = [hm.threshold_code(c) for c in (2e8, 4e8, 1e8, 6e8, 3e8, 1e9, 5e7,
                                               8e8, 1e8, 3e8, 4e8, 6e8, 2e8, 1e8, 5e8)]
 
 
-# k is a register input: each NMS size with one of the two k (both k on the largest window)
-@pytest.mark.parametrize("nms, k", [(1, K04), (3, hm.k_code(0.1)), (5, K04), (5, hm.k_code(0.1))])
+@pytest.mark.parametrize("nms", [1, 3, 5])
+@pytest.mark.parametrize("k", [K04, hm.k_code(0.1)])
 def test_harris_mono_random_small(request, nms, k):
     _run("harris_mono", "tb_harris_mono", dict(width=40, height=30, blocks=(2, 2), nms=nms),
          dict(frames=["random:1", "random:2"], duty=0.5, seed=nms, k=k, thresholds=[0, 5, 100, -3], token_after=90),
          request)
+
+
+def test_harris_mono_fast_numeric_std(request):
+    """The bench with the VHDL player/recorder on GHDL's faster numeric_std (sim/ghdl_ieee.py, what the
+    speed benchmark's fastest GHDL column uses): bit-exact with the model, reset token and idle cycles
+    included (tests/hdl/test_ghdl_ieee.py compares the library itself with IEEE's)."""
+    rep = _run("harris_mono", "tb_harris_mono", dict(width=48, height=36, blocks=(2, 2), nms=3),
+               dict(frames=["random:5", "file:tsukuba_im3.png", "random:6"], duty=0.6, seed=7, k=K04,
+                    thresholds=[0, 5, 100, -3], token_after=120, drivers="hdl", ieee="fast"), request)
+    assert rep["pixels_compared"] == 3 * (48 - 8) * (36 - 8)  # every pixel the model specifies (4 px border)
 
 
 def test_harris_mono_pattern_small(request):

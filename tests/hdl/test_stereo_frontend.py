@@ -18,7 +18,7 @@ from eyestereo.tools.models import stereo_frontend as model
 
 SPEC = "rig:32x24"
 W, H = 32, 24
-FRAMES = {"sequential": 2, "overlapped": 3}  # sequential frames cost a camera frame each (VSYNC waits)
+FRAMES = {"sequential": 3, "overlapped": 3}
 TIMING = dict(h_blank=8, v_sync=1, v_back=1, v_front=1)
 
 
