@@ -15,6 +15,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import NamedTuple
 
 import cv2
 import numpy as np
@@ -54,15 +55,35 @@ def one_line(err: str) -> str:
     return err
 
 
+class Refusal(NamedTuple):
+    """What a refused command did: its status, its standard error, and whether ``folder`` stayed as it was."""
+    status: int
+    err: str
+    unchanged: bool
+
+    def says(self, pieces) -> bool:
+        """One ``eyestereo: error:`` line, no traceback or temporary name, holding every piece."""
+        err = self.err
+        one = err.startswith("eyestereo: error: ") and err.endswith("\n") and err.count("\n") == 1
+        clean = "Traceback" not in err and ".eyestereo-" not in err
+        return one and clean and all(p in err for p in ([pieces] if isinstance(pieces, str) else pieces))
+
+
+def refusal(capfd, folder: Path, *argv) -> Refusal:
+    """Run ``argv``; what it returned, printed and left in ``folder``."""
+    before = snapshot(folder)
+    code, _, err = run(capfd, *argv)
+    return Refusal(code, err, snapshot(folder) == before)
+
+
 def refused(capfd, folder: Path, status: int, pieces, *argv) -> str:
     """Run ``argv``; assert the status, one line holding every piece, and ``folder`` unchanged."""
-    before = snapshot(folder)
-    code, out, err = run(capfd, *argv)
-    assert code == status, (argv, err)
-    line = one_line(err)
+    r = refusal(capfd, folder, *argv)
+    assert r.status == status, (argv, r.err)
+    line = one_line(r.err)
     for piece in [pieces] if isinstance(pieces, str) else pieces:
         assert piece in line, (piece, line)
-    assert snapshot(folder) == before, argv
+    assert r.unchanged, argv
     return line
 
 
@@ -149,7 +170,8 @@ def test_an_unusable_calibration_file_names_the_camera_and_the_remedy(capfd, box
         setattr(cal, k, np.array(v))
     C.write_yaml(cal, box / "calib.yml")
     out = box / ("o.npz" if command == "maps" else "o")
-    refused(capfd, box, 1, pieces, command, box / "calib.yml", "-o", out)
+    r = refusal(capfd, box, command, box / "calib.yml", "-o", out)
+    assert r.status == 1 and r.unchanged and r.says(pieces), r
 
 
 def test_judge_conditioning_and_coverage():
@@ -183,7 +205,9 @@ def test_rig_failing_part_way_leaves_no_images(capfd, box, monkeypatch):
         raise ValueError("cannot write the calibration")
 
     monkeypatch.setattr(G, "write_yaml", boom)
-    refused(capfd, box, 1, "cannot write the calibration", "rig", "--views", "2", "-o", box / "newrig")
+    r = refusal(capfd, box, "rig", "--views", "2", "-o", box / "newrig")
+    assert r.status == 1 and r.unchanged and r.says("cannot write the calibration"), r
+    assert not (box / "newrig").exists()
 
 
 @pytest.mark.parametrize("sig, status, name", [(signal.SIGTERM, 143, "SIGTERM"), (signal.SIGINT, 130, "SIGINT")])
@@ -214,8 +238,10 @@ def test_a_signal_leaves_nothing_behind(world, tmp_path, sig, status, name):
 def test_an_existing_folder_that_is_not_ours_is_refused_everywhere(capfd, box, argv):
     (box / "mine").mkdir()
     (box / "mine" / "thesis.tex").write_text("keep me")
-    refused(capfd, box, 1, ["mine holds thesis.tex, which this command does not write", "give a new or empty folder"],
-            *(a.format(d=box, o=box / "mine") for a in argv))
+    r = refusal(capfd, box, *(a.format(d=box, o=box / "mine") for a in argv))
+    assert r.status == 1 and r.unchanged, r
+    assert r.says(["mine holds thesis.tex, which this command does not write", "give a new or empty folder"]), r
+    assert (box / "mine" / "thesis.tex").read_text() == "keep me"
 
 
 def test_an_earlier_folder_of_ours_is_replaced_as_a_whole(capfd, box):
@@ -253,8 +279,8 @@ def test_an_existing_file_is_replaced_keeping_its_mode_and_a_folder_is_refused(c
 @pytest.mark.parametrize("name, piece", [("cut.png", "truncated PNG"), ("cut.jpg", "truncated JPEG")])
 def test_truncated_images_are_refused_by_every_command(capfd, box, name, piece):
     bad = box / name
-    refused(capfd, box, 1, [f"{bad} is a {piece}"], "warp", bad, box / "maps.npz", "--side", "left", "-o",
-            box / "w.png")
+    r = refusal(capfd, box, "warp", bad, box / "maps.npz", "--side", "left", "-o", box / "w.png")
+    assert r.status == 1 and r.unchanged and r.says(f"{bad} is a {piece}"), r
     glob_dir = box / "pairs"
     glob_dir.mkdir()
     ext = Path(name).suffix
@@ -263,9 +289,10 @@ def test_truncated_images_are_refused_by_every_command(capfd, box, name, piece):
             img = cv2.imread(str(box / "rig" / f"{side}0{i}.png"), cv2.IMREAD_GRAYSCALE)
             cv2.imwrite(str(glob_dir / f"{side}0{i}{ext}"), img)
     (glob_dir / f"left02{ext}").write_bytes(bad.read_bytes())
-    refused(capfd, box, 1, [f"left02{ext}", piece], "calibrate", glob_dir / "left*", glob_dir / "right*", "-o",
-            box / "c.yml")
-    refused(capfd, box, 1, [f"right image {bad}", piece], "evaluate", box / "cam.png", bad, box / "cam.png")
+    r = refusal(capfd, box, "calibrate", glob_dir / "left*", glob_dir / "right*", "-o", box / "c.yml")
+    assert r.status == 1 and r.unchanged and r.says([f"left02{ext}", piece]), r
+    r = refusal(capfd, box, "evaluate", box / "cam.png", bad, box / "cam.png")
+    assert r.status == 1 and r.unchanged and r.says([f"right image {bad}", piece]), r
 
 
 def test_16_bit_images_are_handled(capfd, box):
@@ -287,9 +314,10 @@ def test_16_bit_images_are_handled(capfd, box):
 def test_floating_point_images_are_refused(capfd, box):
     for argv in (["warp", box / "float.tiff", box / "maps.npz", "--side", "left", "-o", box / "w.png"],
                  ["evaluate", box / "float.tiff", box / "cam.png", box / "cam.png"]):
-        refused(capfd, box, 1, ["float.tiff holds floating-point pixels", "8- or 16-bit PNG"], *argv)
-    refused(capfd, box, 1, "is 16-bit, which .jpg cannot hold", "warp", box / "cam16.png", box / "maps.npz",
-            "--side", "left", "-o", box / "w.jpg")
+        r = refusal(capfd, box, *argv)
+        assert r.status == 1 and r.unchanged and r.says(["float.tiff holds floating-point pixels", "8- or 16-bit PNG"]), r
+    r = refusal(capfd, box, "warp", box / "cam16.png", box / "maps.npz", "--side", "left", "-o", box / "w.jpg")
+    assert r.status == 1 and r.unchanged and r.says("is 16-bit, which .jpg cannot hold"), r
 
 
 # --------------------------------------------------------------------------------------------------
@@ -354,11 +382,14 @@ def test_the_same_mistake_gives_the_same_status_in_every_command(capfd, box, com
     first_input = next(i for i, a in enumerate(argv) if str(box) in a)
     missing = list(argv)
     missing[first_input] = str(box / "missing.file")
-    refused(capfd, box, 1, ["missing.file", "does not exist" if command != "calibrate" else "no left images match"],
-            command, *missing)
-    refused(capfd, box, 2, "unrecognized arguments: --frobnicate", command, *argv, "--frobnicate")
+    r = refusal(capfd, box, command, *missing)
+    assert r.status == 1 and r.unchanged, r
+    assert r.says(["missing.file", "does not exist" if command != "calibrate" else "no left images match"]), r
+    r = refusal(capfd, box, command, *argv, "--frobnicate")
+    assert r.status == 2 and r.unchanged and r.says("unrecognized arguments: --frobnicate"), r
     nodir = [a.replace(f"{box}/o", f"{box}/nodir/o") for a in argv]
-    refused(capfd, box, 1, f"{box}/nodir", command, *nodir)
+    r = refusal(capfd, box, command, *nodir)
+    assert r.status == 1 and r.unchanged and r.says(f"{box}/nodir"), r
 
 
 def test_outputs_get_the_users_umask(capfd, box):
@@ -411,16 +442,18 @@ def test_implausible_quantizer_files_are_refused(capfd, box, edit, piece):
     doc = json.loads((box / "quantizers.json").read_text())
     edit(doc)
     (box / "quantizers.json").write_text(json.dumps(doc))
-    refused(capfd, box, 1, piece, "package", box / "quantizers.json", "-o", box / "pkg.vhd")
+    r = refusal(capfd, box, "package", box / "quantizers.json", "-o", box / "pkg.vhd")
+    assert r.status == 1 and r.unchanged and r.says(piece), r
 
 
 def test_implausible_sizes_are_refused(capfd, box):
-    refused(capfd, box, 2, "at most 16777216", "maps", box / "calib.yml", "--size", "16384x16384", "-o",
-            box / "m.npz")
+    r = refusal(capfd, box, "maps", box / "calib.yml", "--size", "16384x16384", "-o", box / "m.npz")
+    assert r.status == 2 and r.unchanged and r.says("at most 16777216"), r
     doc = json.loads((box / "poly.json").read_text())
     doc["width"] = 10 ** 9
     (box / "poly.json").write_text(json.dumps(doc))
-    refused(capfd, box, 1, "width 1000000000 is implausible", "ffc", box / "poly.json", "-o", box / "q.json")
+    r = refusal(capfd, box, "ffc", box / "poly.json", "-o", box / "q.json")
+    assert r.status == 1 and r.unchanged and r.says("width 1000000000 is implausible"), r
 
 
 def test_a_signal_whose_exception_was_swallowed_still_ends_the_command(capfd, tmp_path):
