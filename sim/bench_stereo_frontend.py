@@ -33,6 +33,7 @@ import sys
 import time
 from pathlib import Path
 
+from eyestereo.sim.cli_system import frame_size
 from eyestereo.sim.runner import ROOT, run_bench, verilator_root
 from eyestereo.tools.camera import CameraTiming
 from eyestereo.tools.models.sram_arbiter import MASTERS
@@ -508,13 +509,7 @@ def resources_section() -> list[str]:
 
 
 def _size(text: str) -> str:
-    try:
-        w, h = (int(v) for v in text.lower().split("x"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected WxH like 48x32, got {text!r}") from None
-    if not (16 <= w <= 352 and 16 <= h <= 288 and w % 2 == 0):
-        raise argparse.ArgumentTypeError(f"size {text}: width even, 16..352 x 16..288")
-    return f"{w}x{h}"
+    return "{}x{}".format(*frame_size(text))
 
 
 def main(argv=None) -> int:

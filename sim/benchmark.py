@@ -33,6 +33,7 @@ import numpy as np
 
 from eyestereo.hdl import synth
 from eyestereo.sim.runner import BUILD, ROOT, build_dir_of, run_bench, simulator_versions, slug
+from eyestereo.tools.io import atomic_write_text
 
 W, H = 352, 288
 IMAGES = ["file:tsukuba_im3.png", "file:chessboard_left01.jpg"]
@@ -499,9 +500,7 @@ def main(argv=None) -> int:
     missing = [c[0] for c in cases if not any(r["name"] == c[0] for r in results)]
     text = report(results, sims, simulator_versions(), missing=missing) + NOTES + "\n" + synth_section(args.out)
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = args.out.with_suffix(".tmp")
-    tmp.write_text(text)
-    tmp.replace(args.out)
+    atomic_write_text(args.out, text)
     print(text)
     return 0
 

@@ -30,13 +30,14 @@ from eyestereo.tools.models.sram_arbiter import MASTERS
 MODES = ("sequential", "overlapped")
 
 
-def _size(text: str) -> tuple[int, int]:
+def frame_size(text: str) -> tuple[int, int]:
+    """A camera size for the front end, ``WxH``: width even, 16..352 x 16..288 (argparse type)."""
     try:
         w, h = (int(v) for v in text.lower().split("x"))
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected WxH like 48x32, got {text!r}") from None
     if not (16 <= w <= 352 and 16 <= h <= 288 and w % 2 == 0):
-        raise argparse.ArgumentTypeError(f"--size {text}: width even, 16..352 x 16..288")
+        raise argparse.ArgumentTypeError(f"size {text}: width even, 16..352 x 16..288")
     return w, h
 
 
@@ -48,7 +49,7 @@ def add_system(sub: Any) -> None:
     p.add_argument("right", type=Path, help="right camera image")
     p.add_argument("-o", "--output", type=Path, required=True, help="folder for rectified.png and summary.json")
     p.add_argument("--json", type=Path, help="also write the figures to this file")
-    p.add_argument("--size", type=_size, default=(48, 32), help="camera size WxH (default 48x32)")
+    p.add_argument("--size", type=frame_size, default=(48, 32), help="camera size WxH (default 48x32)")
     p.add_argument("--frames", type=int, default=2, help="stereo frames the host reads per mode (default 2)")
     p.add_argument("--modes", default="sequential,overlapped", help="comma list of modes (default both)")
     p.add_argument("--sim", choices=("ghdl", "icarus", "verilator"), default=None,

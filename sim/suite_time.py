@@ -20,6 +20,8 @@ import sys
 import time
 from pathlib import Path
 
+from eyestereo.tools.io import atomic_write_text
+
 ROOT = Path(__file__).resolve().parent.parent
 SLOWEST = 15
 
@@ -75,9 +77,7 @@ def main(argv=None) -> int:
         return 1
     text = document(res, args.jobs)
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = args.out.with_suffix(".tmp")
-    tmp.write_text(text)
-    tmp.replace(args.out)
+    atomic_write_text(args.out, text)
     print(text)
     return 0
 
