@@ -154,13 +154,34 @@ def lint_vhdl(files: list[Path]) -> None:
                                    f"always-true/false test out of the block")
 
 
-def _ghdl_synth(files: list[Path], top: str, out: str, std: str, workdir: Path) -> str:
+def ghdl_synth(files: list[Path], top: str, out: str, std: str, workdir: Path) -> str:
+    """``ghdl synth --out=OUT`` of ``top`` from the VHDL ``files``: the netlist's text (NetlistError on failure)."""
     cmd = ["ghdl", "synth", f"--std={std}", f"--workdir={workdir}", f"--out={out}"] + \
           [str(f) for f in files] + ["-e", top]
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
         raise NetlistError(f"ghdl synth --out={out} failed on {top}:\n{r.stderr[-3000:]}")
     return r.stdout
+
+
+def ghdl_vhdl_netlist(files: list[Path], top: str, build_dir: Path) -> Path:
+    """GHDL's synthesized VHDL netlist of ``top`` (``ghdl synth --std=08 --out=vhdl``), as ``<top>_netlist.vhd``.
+
+    The same entity and ports as the VHDL (it still uses the MyHDL package), one architecture of
+    GHDL's netlist cells; written next to the VHDL in ``build_dir``.
+    """
+    lint_vhdl(files)
+    work = Path(build_dir) / "ghdl_synth"
+    work.mkdir(parents=True, exist_ok=True)
+    text = ghdl_synth(files, top, "vhdl", "08", work)
+    # GHDL 2.0 writes a 1-bit unsigned/signed port's inner net as a std_logic scalar and converts it
+    # with a type conversion its own analyser refuses (``unresolved_unsigned(wrap_x)``): an aggregate.
+    scalars = set(re.findall(r"^\s*signal (wrap_\w+): std_logic;", text, re.M))
+    text = re.sub(r"\bunresolved_(?:un)?signed\s*\((wrap_\w+)\)",
+                  lambda m: f"(0 => {m.group(1)})" if m.group(1) in scalars else m.group(0), text)
+    path = Path(build_dir) / f"{top}_netlist.vhd"
+    path.write_text(text)
+    return path
 
 
 def ghdl_netlist(files: list[Path], top: str, out_dir: Path, *, std: str = "08") -> Path:
@@ -175,8 +196,8 @@ def ghdl_netlist(files: list[Path], top: str, out_dir: Path, *, std: str = "08")
     lint_vhdl(files)
     work = out_dir / "ghdl_synth"
     work.mkdir(parents=True, exist_ok=True)
-    verilog = _ghdl_synth(files, top, "verilog", std, work)
-    vhdl = _ghdl_synth(files, top, "vhdl", std, work)
+    verilog = ghdl_synth(files, top, "verilog", std, work)
+    vhdl = ghdl_synth(files, top, "vhdl", std, work)
     (out_dir / f"{top}_netlist.vhd").write_text(vhdl)
     text, counts = repair(verilog, vhdl)
     path = out_dir / f"{top}_netlist.v"

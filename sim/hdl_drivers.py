@@ -259,7 +259,6 @@ class HdlStreamSink(SinkResults):
     def cycle(self) -> int:
         return self.time.cycle()
 
-
     def _fail(self, msg: str) -> None:
         if self.error is None:
             self.error = ProtocolError(msg)

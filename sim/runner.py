@@ -183,9 +183,10 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
     cocotb test fails or no test ran.
 
     ``config["design"]``: ``"vhdl"`` (default) simulates the block's VHDL; ``"netlist"`` (GHDL only)
-    simulates GHDL's own synthesized VHDL netlist of it instead (:func:`ghdl_vhdl_netlist`), with either
-    kind of drivers: the same bench and model checks on the circuit synthesis sees. Measured for issue 9
-    (docs/benchmarks.md): bit-exact, but about half the VHDL's speed on GHDL.
+    simulates GHDL's own synthesized VHDL netlist of it instead
+    (:func:`eyestereo.hdl.netlist.ghdl_vhdl_netlist`), with either kind of drivers: the same bench and
+    model checks on the circuit synthesis sees. Measured for issue 9 (docs/benchmarks.md): bit-exact,
+    but about half the VHDL's speed on GHDL.
 
     ``config["ieee"]`` (GHDL only; default ``$GHDL_IEEE`` or ``"standard"``): ``"fast"`` simulates against
     an ieee library whose numeric_std body adds and multiplies without per-bit function calls
@@ -225,6 +226,8 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
 
                 wrapper, bits = write_wrapper(sources[-1], block, build_dir)
             if netlist:
+                from eyestereo.hdl.netlist import ghdl_vhdl_netlist
+
                 sources[-1] = ghdl_vhdl_netlist(sources, block, build_dir)
             if wrapper is not None:
                 sources.append(wrapper)
@@ -235,7 +238,8 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
             opt = GHDL_LLVM_ARGS if os.environ["GHDL_BACKEND"] == "llvm" else []
             lib = []
             if fast_ieee:
-                lib = ["--ieee=none", f"-P{ghdl_ieee.library(BUILD.parent / 'ghdl_ieee', os.environ['GHDL_BACKEND']) / 'ieee' / 'v08'}"]
+                fast = ghdl_ieee.library(BUILD.parent / "ghdl_ieee", os.environ["GHDL_BACKEND"])
+                lib = ["--ieee=none", f"-P{fast / 'ieee' / 'v08'}"]
             runner.build(sources=[str(s) for s in sources], hdl_toplevel=top, build_dir=build_dir,
                          build_args=GHDL_ARGS + lib + opt, always=True, waves=waves, **logs)
             results = runner.test(hdl_toplevel=top, hdl_toplevel_lang="vhdl",
@@ -268,28 +272,6 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
     if seconds is not None:
         out.setdefault("sim_seconds", seconds)
     return out
-
-
-def ghdl_vhdl_netlist(files: list[Path], top: str, build_dir: Path) -> Path:
-    """GHDL's synthesized VHDL netlist of ``top`` (``ghdl synth --std=08 --out=vhdl``), as ``<top>_netlist.vhd``.
-
-    The same entity and ports as the VHDL (it still uses the MyHDL package), one architecture of
-    GHDL's netlist cells; written next to the VHDL in ``build_dir``.
-    """
-    from eyestereo.hdl.netlist import _ghdl_synth, lint_vhdl
-
-    lint_vhdl(files)
-    work = Path(build_dir) / "ghdl_synth"
-    work.mkdir(parents=True, exist_ok=True)
-    text = _ghdl_synth(files, top, "vhdl", "08", work)
-    # GHDL 2.0 writes a 1-bit unsigned/signed port's inner net as a std_logic scalar and converts it
-    # with a type conversion its own analyser refuses (``unresolved_unsigned(wrap_x)``): an aggregate.
-    scalars = set(re.findall(r"^\s*signal (wrap_\w+): std_logic;", text, re.M))
-    text = re.sub(r"\bunresolved_(?:un)?signed\s*\((wrap_\w+)\)",
-                  lambda m: f"(0 => {m.group(1)})" if m.group(1) in scalars else m.group(0), text)
-    path = Path(build_dir) / f"{top}_netlist.vhd"
-    path.write_text(text)
-    return path
 
 
 def sim_seconds(build_dir: Path) -> float | None:

@@ -223,7 +223,6 @@ class StreamSink(SinkResults):
         """Rising edges since the sink started."""
         return self.time.cycle()
 
-
     def _fail(self, msg: str) -> None:
         if self.error is None:
             self.error = ProtocolError(msg)
