@@ -34,7 +34,7 @@ import time
 from pathlib import Path
 
 from eyestereo.sim.cli_system import frame_size
-from eyestereo.sim.runner import ROOT, run_bench, verilator_root
+from eyestereo.sim.runner import ROOT, fastest_simulator, run_bench
 from eyestereo.tools.camera import CameraTiming
 from eyestereo.tools.models.sram_arbiter import MASTERS
 
@@ -52,10 +52,6 @@ PUBLIC = ["clk", "rst", "hclk", "hrst", "wrst_*", "cam_*", "bus_*", "sram_*", "r
           "frontend_sequencer*_list_done", "sram_subsystem*_cam_held"]
 SIM_NAMES = {"verilator": "Verilator (MyHDL's Verilog of the top)", "icarus": "Icarus Verilog",
              "ghdl": "GHDL (mcode)", "ghdl-llvm": "GHDL (LLVM back end, -O2)"}
-
-
-def fastest_simulator() -> str:
-    return "verilator" if verilator_root() is not None else "ghdl"
 
 
 def timing_of(size: str) -> dict:
@@ -474,8 +470,11 @@ def write_doc(path: Path, *, size: str, figs: dict, small: tuple | None, ghdl: t
 
 #: The Spartan-3E 500 (XC3S500E).
 DEVICE = dict(LUT=9312, FF=9312, RAMB16=20, MULT18X18=20)
-#: make synth's figures of the default top, used when build/synth/resources.json is not there (docs/benchmarks.md)
-SYNTH_FALLBACK = dict(LUT=5941, LUTRAM=252, FF=6186, RAMB16=16, MULT18X18=19)
+#: make synth's row of the default top (2026-12-01, docs/benchmarks.md), used when build/synth/resources.json
+#: is not there
+SYNTH_FALLBACK = dict(summary=dict(LUT=5770, LUTRAM=252, FF=6186, RAMB16=16, MULT18X18=19),
+                      fmax=dict(clk=81.05, hclk=84.05, cam_l_pclk=132.66, cam_r_pclk=122.8),
+                      ecp5_device="--85k --package CABGA756 --speed 6")
 
 
 def resources_section() -> list[str]:
@@ -485,7 +484,8 @@ def resources_section() -> list[str]:
     rows = [r for r in (json.loads(f.read_text()) if f.is_file() else []) if r.get("block") == "stereo_frontend"
             and not r.get("params")]
     out = ["## Resources of the whole system", ""]
-    s = rows[-1]["summary"] if rows else SYNTH_FALLBACK
+    row = rows[-1] if rows else SYNTH_FALLBACK
+    s = row["summary"]
     luts = s["LUT"] + s["LUTRAM"]  # distributed RAM occupies LUTs of SLICEMs
     used = dict(LUT=luts, FF=s["FF"], RAMB16=s["RAMB16"], MULT18X18=s["MULT18X18"])
     out += ["`python -m eyestereo.hdl.synth --block stereo_frontend --no-pnr`: GHDL's synthesis of the generated VHDL "
@@ -500,11 +500,14 @@ def resources_section() -> list[str]:
     out += ["", f"It {'fits' if fits else 'does not fit'}: the multipliers are the tight resource (rectifier 12, "
             "harris_stereo at share 1 7); share 2 would free 3 but cannot take the rectifier's stream without a "
             "pacing buffer. Carry cells (MUXCY/XORCY) use no LUT. Yosys counts, not ISE's: the thesis's own "
-            "figures came from ISE 10.", "",
-            "`make synth` on the merged main (after cornerness_stereo's Verilog-safe subtraction, "
-            "docs/benchmarks.md) measured the same top at 5770 LUT + 252 LUT-RAM, 6186 FF, 16 RAMB16, 19 MULT18X18, "
-            "and placed it on an ECP5 (LFE5U-85F): memory clock 81.0 MHz (below the 100 MHz goal), Harris clock "
-            "84.0 MHz, camera clocks 122.8 / 132.7 MHz.", ""]
+            "figures came from ISE 10.", ""]
+    fmax = {k: (v["achieved"] if isinstance(v, dict) else v) for k, v in (row.get("fmax") or {}).items()}
+    if fmax:
+        names = dict(clk="memory clock", hclk="Harris clock", cam_l_pclk="left camera", cam_r_pclk="right camera")
+        goals = dict(clk=100.0, hclk=50.0, cam_l_pclk=18.0, cam_r_pclk=18.0)
+        out += [f"Placed by `make synth` on an ECP5 (`nextpnr-ecp5 {row.get('ecp5_device', '?')}`), fmax per clock: "
+                + ", ".join(f"{names.get(k, k)} {v:.1f} MHz (goal {goals.get(k, '?')})" for k, v in fmax.items())
+                + ".", ""]
     return out
 
 

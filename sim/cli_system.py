@@ -121,8 +121,8 @@ def main_system(left: Path, right: Path, output: Path, *, size=(48, 32), frames:
                 modes=("sequential", "overlapped"), sim: str | None = None) -> dict:
     """Run the system (see the module doc) and write OUTPUT/; returns the summary. Raises AssertionError
     when the simulation fails."""
-    from eyestereo.sim.bench_stereo_frontend import PUBLIC, fastest_simulator, figures, sim_label
-    from eyestereo.sim.runner import run_bench
+    from eyestereo.sim.bench_stereo_frontend import PUBLIC, figures, sim_label
+    from eyestereo.sim.runner import fastest_simulator, run_bench
     from eyestereo.tools.camera import CameraTiming
 
     w, h = size

@@ -119,7 +119,7 @@ def main(argv=None) -> int:
     out: Path = args.out.resolve()
     out.mkdir(parents=True, exist_ok=True)
     steps = StepRunner(out / "logs", width=29)
-    from eyestereo.sim.bench_stereo_frontend import fastest_simulator
+    from eyestereo.sim.runner import fastest_simulator
 
     system_sim = fastest_simulator()
     frame = make_frame(f"file:{IMAGE}", WIDTH, HEIGHT)
