@@ -163,7 +163,6 @@ def main(argv=None) -> int:
         scenes = [cv2.resize(img[100:196, x0:x0 + 128], (w, h), interpolation=cv2.INTER_AREA) for x0 in (150, 156)]
         write_png(lp, rig_view(scenes[0], "left"))
         write_png(rp, rig_view(scenes[1], "right"))
-        w, h = SYSTEM_SIZE
         summary = main_system(lp, rp, out / "system", size=SYSTEM_SIZE, frames=SYSTEM_FRAMES, modes=SYSTEM_MODES,
                               sim=system_sim)
         (out / "system.json").write_text(json.dumps(summary, indent=2) + "\n")
