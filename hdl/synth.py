@@ -89,9 +89,12 @@ ECP5 = ("--25k", "--package", "CABGA381", "--speed", "6")
 ECP5_WIDE = ("--85k", "--package", "CABGA756", "--speed", "6")
 ECP5_IOS = 197
 #: User I/O of ECP5_WIDE's package (LFE5U-85F, CABGA756). A block with more port bits (the register bank:
-#: the AXI4-Lite port and one port per register field) is not placed; its fmax cell says so, and its
-#: Spartan-3E estimate (eyestereo.hdl.sta) stands for its logic depth.
+#: the AXI4-Lite port and one port per register field, which in a design go to other logic, not to pins) is
+#: placed out of context on the ECP5 device instead (nextpnr's ``--out-of-context``: no I/O buffers, ports
+#: left as internal nets, clocks on general routing): its fmax is that of its register-to-register paths, and
+#: its cell says "out of context".
 ECP5_WIDE_IOS = 365
+ECP5_OOC = ("--out-of-context",)
 
 
 def _port_bits(netlist_json: Path, top: str) -> int:
@@ -237,10 +240,7 @@ def ecp5(job: dict, *, freq: float = 100.0, seed: int = 1) -> dict:
     (d / "ecp5.lpf").write_text("".join(f'FREQUENCY PORT "{c}" {freq:.1f} MHz;\n' for c in clocks))
     t0 = time.perf_counter()
     bits = _port_bits(d / "ecp5.json", job["block"])
-    if bits > ECP5_WIDE_IOS:
-        return dict(fmax={}, ecp5={}, ecp5_device=f"not placed: {bits} port bits, more than the {ECP5_WIDE_IOS} I/O "
-                    "of the largest package")
-    device = ECP5 if bits <= ECP5_IOS else ECP5_WIDE
+    device = ECP5 if bits <= ECP5_IOS else ECP5_WIDE if bits <= ECP5_WIDE_IOS else ECP5 + ECP5_OOC
     cmd = nextpnr_command() + list(device) + [
         "--json", "ecp5.json", "--lpf", "ecp5.lpf", "--lpf-allow-unconstrained", "--timing-allow-fail",
         "--seed", str(seed), "--report", "pnr_report.json", "--log", "nextpnr.log", "-q"]
@@ -256,6 +256,8 @@ def ecp5(job: dict, *, freq: float = 100.0, seed: int = 1) -> dict:
     out = dict(fmax=fmax, ecp5=util, pnr_seconds=round(time.perf_counter() - t0, 1))
     if device != ECP5:
         out["ecp5_device"] = " ".join(device)
+    if device == ECP5 + ECP5_OOC:
+        out["out_of_context"] = f"{bits} port bits, more than the {ECP5_WIDE_IOS} I/O of the largest package"
     return out
 
 
@@ -272,13 +274,13 @@ def synth_block(name: str, out: Path, *, label: str | None = None, pnr: bool = F
 def _fmax_cell(r: dict) -> str:
     fm = r.get("fmax")
     if not fm:
-        return "not placed: more port bits than I/O" if str(r.get("ecp5_device", "")).startswith("not placed") else "-"
+        return "-"
     parts = []
     for clk, v in fm.items():
         a = v.get("achieved")
         val = f"{a:.1f}" if a is not None else "no reg-to-reg path"
         parts.append(val if len(fm) == 1 else f"{clk}: {val}")
-    return ", ".join(parts)
+    return ", ".join(parts) + (" (out of context)" if r.get("out_of_context") else "")
 
 
 def _goal_cell(r: dict) -> str:
@@ -325,6 +327,14 @@ def table(results: list[dict]) -> str:
                   "not what ISE reaches on a Spartan-3E. ECP5 LUT4 counts include the LUTs of the carry "
                   "chains (CCU2C). 'no reg-to-reg path': every path runs from an input to an output, "
                   "which nextpnr does not time here."]
+        wide = [r.get("label", r["block"]) for r in results if r.get("ecp5_device") == " ".join(ECP5_WIDE)]
+        ooc = [f"{r.get('label', r['block'])} ({r['out_of_context']})" for r in results if r.get("out_of_context")]
+        if wide:
+            lines.append(f"Placed on the LFE5U-85F ({' '.join(ECP5_WIDE)}) because they have more port bits than "
+                         f"the 25k's package has I/O ({ECP5_IOS}): {', '.join(wide)}.")
+        if ooc:
+            lines.append("Placed out of context (`--out-of-context`: no I/O buffers, the ports stay internal nets, "
+                         "as when the block sits inside a design; clocks on general routing): " + ", ".join(ooc) + ".")
     return "\n".join(lines) + "\n"
 
 
