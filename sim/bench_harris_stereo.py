@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import datetime
 import json
+import os
 import time
 from pathlib import Path
 
@@ -35,7 +36,7 @@ from eyestereo.hdl.harris_window_stereo import harris_window_stereo
 from eyestereo.hdl.nms_stereo import nms_stereo
 from eyestereo.hdl.prethreshold_stereo import prethreshold_stereo
 from eyestereo.hdl.sobel_stereo import sobel_stereo
-from eyestereo.sim.runner import ROOT, run_bench
+from eyestereo.sim.runner import ROOT, hdl_revision, run_bench
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import harris_mono as hm
 from eyestereo.tools.models import harris_window as window_model
@@ -95,7 +96,9 @@ def crop(path: Path) -> np.ndarray:
 def sim_entry(share: int, rep: dict, names, duty, wall: float) -> dict:
     clocks = rep["last_out"] - rep["first_in"] + 1
     return dict(pairs=names, duty=duty, wall_s=round(wall, 1), **rep, clocks=clocks,
-                beats_per_clock=rep["beats_in"] / clocks)
+                beats_per_clock=rep["beats_in"] / clocks, revision=hdl_revision(),
+                backend=os.environ.get("GHDL_BACKEND", "mcode"), ieee=os.environ.get("GHDL_IEEE", "standard"),
+                load=round(os.getloadavg()[0], 1), date=str(datetime.date.today()))
 
 
 def model_corners(names, shared: Path) -> list[list[int]]:
@@ -140,11 +143,27 @@ def run_synth(shares, stages=None) -> dict:
     out = {}
     jobs = [(n, n, {}) for n in TABLE_6_4 if stages is None or n in stages]
     jobs += [(f"harris_stereo share {s}", "harris_stereo", dict(share=s)) for s in shares]
+    if stages is None:
+        jobs.append(("feature_list", "feature_list", {}))
     for label, name, params in jobs:
         t0 = time.perf_counter()
         r = synth_block(name, BUILD / "synth", label=label, **params)
-        out[label] = dict(summary=r["summary"], seconds=round(time.perf_counter() - t0, 1))
+        out[label] = dict(summary=r["summary"], seconds=round(time.perf_counter() - t0, 1), revision=hdl_revision(),
+                          date=str(datetime.date.today()))
         print(f"{label}: {r['summary']}", flush=True)
+    return out
+
+
+def _make_synth_fmax() -> dict:
+    """fmax of harris_stereo (share 3) and feature_list from make synth's last run, where it has them."""
+    f = ROOT / "build" / "synth" / "resources.json"
+    if not f.exists():
+        return {}
+    out = {}
+    for r in json.loads(f.read_text()):
+        if r.get("label") in ("harris_stereo", "feature_list") and (r.get("fmax") or {}).get("clk", {}).get("achieved"):
+            name = "harris_stereo share 3" if r["label"] == "harris_stereo" else r["label"]
+            out[name] = r["fmax"]["clk"]["achieved"]
     return out
 
 
@@ -196,11 +215,13 @@ def render(sim: dict | None, synth: dict | None) -> str:
                   "duty cycles and reset tokens are covered by the small-frame regressions, "
                   "tests/hdl/test_harris_stereo_sim.py); the bench also checks that no valid beat has an "
                   "undefined bit and nothing is left over.", "",
-                  "| share | stereo pairs (centre 352x288) | flags compared | corners left / right | GHDL wall time (2 cores shared by 5 sessions) |",
-                  "|---:|---|---:|---|---:|"]
+                  "| share | stereo pairs (centre 352x288) | flags compared | corners left / right | GHDL back end, numeric_std | wall time (1-min load at the end) | date | HDL revision |",
+                  "|---:|---|---:|---|---|---:|---|---|"]
         for s, r in sorted(sim.items()):
             fl = ", ".join(f"{a} / {b}" for a, b in r.get("corners", []))
-            lines.append(f"| {s} | {' + '.join(r['pairs'])} | {r['pixels_compared']} | {fl} | {r['wall_s']:.0f} s |")
+            lines.append(f"| {s} | {' + '.join(r['pairs'])} | {r['pixels_compared']} | {fl} | "
+                         f"{r.get('backend', 'mcode')}, {r.get('ieee', 'standard')} | {r['wall_s']:.0f} s "
+                         f"({r.get('load', '?')}) | {r.get('date', '?')} | {r.get('revision', '?')} |")
         lines += ["", "## Throughput and latency", "",
                   "Measured in the same runs: beats in per clock from the first beat in to the last flag out (one "
                   "pair, so the latency and the frame's tail are included: the limit is one beat per `share` "
@@ -253,9 +274,12 @@ def render(sim: dict | None, synth: dict | None) -> str:
             lines.append("| feature_list (352x288, 4x4 count blocks, FIFO 16) | " + " | ".join(str(v) for v in row)
                          + " | (not in Table 6.4) |")
         lines += [""]
-        fm = synth.get("fmax_ecp5") or {}
+        revs = sorted({v.get("revision", "?") for v in synth.values() if isinstance(v, dict) and "summary" in v})
+        lines += [f"HDL revision of these netlists: {', '.join(revs)}.", ""]
+        fm = _make_synth_fmax()
         if fm:
-            lines += ["fmax from the same netlists through Yosys `synth_ecp5` + nextpnr-ecp5 (LFE5U-25F, speed 6; "
+            lines += ["fmax from `make synth` (`build/synth/resources.json`: the same flow on the catalogue's default "
+                      "configurations, GHDL's netlist through Yosys `synth_ecp5` + nextpnr-ecp5, LFE5U-25F, speed 6; "
                       "the thesis's goal is 50 MHz): " + ", ".join(f"{k} {v:.1f} MHz" for k, v in fm.items()) + ".", ""]
         lines += ["Against Table 6.4, every module is at or under the thesis's LUTs, block RAMs and multipliers; "
                   "the whole detector at share 3 takes the thesis's 12 block RAMs and 3 multipliers (two mono "

@@ -35,7 +35,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from eyestereo.sim.runner import BUILD, ROOT, run_bench, slug
+from eyestereo.sim.runner import BUILD, ROOT, hdl_revision, run_bench, slug
 from eyestereo.tools.io import atomic_write_text
 
 OUT = ROOT / "build" / "bench_rectifier"
@@ -148,24 +148,11 @@ def run_frame(label: str, spec: str, left: np.ndarray, right: np.ndarray, mem: d
     t0 = time.perf_counter()
     rep = run_bench("rectifier", "tb_rectifier", cfg, name=f"bench_{slug(label)}", params=dict(quantizers=spec))
     rep.update(label=label, spec=spec, memory=mem, seed=seed, wall=time.perf_counter() - t0,
-               backend=os.environ.get("GHDL_BACKEND", "mcode"), revision=_revision())
+               backend=os.environ.get("GHDL_BACKEND", "mcode"), revision=hdl_revision())
     (folder / "report.json").write_text(json.dumps(rep, indent=2) + "\n")
     print(f"bench_rectifier: {label}: {rep['clocks_per_pixel']:.3f} clocks/px, {rep['reads_per_output_pixel']:.3f} "
           f"reads/px, bit exact {rep['bit_exact']}, {rep['wall']:.0f} s", flush=True)
     return rep
-
-
-def _revision() -> str:
-    """The commit the HDL was converted from (``+`` when the HDL has uncommitted changes)."""
-    import subprocess
-
-    try:
-        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain", "hdl", "tools/models"], cwd=ROOT, capture_output=True,
-                               text=True).stdout.strip()
-    except OSError:
-        return "?"
-    return head + ("+" if dirty else "")
 
 
 def frames_to_run(quick: bool) -> list[tuple[str, str, str, dict, int]]:
@@ -319,8 +306,8 @@ def resources(reuse: bool = False) -> list[dict]:
         except (FileNotFoundError, RuntimeError, ValueError) as exc:
             print(f"bench_rectifier: skipped {label}: {exc}", file=sys.stderr)
             continue
-        out.append(dict(label=label, block=block, revision=_revision(), **r["summary"]))
-        (folder / slug(label) / "revision.txt").write_text(_revision() + "\n")
+        out.append(dict(label=label, block=block, revision=hdl_revision(), **r["summary"]))
+        (folder / slug(label) / "revision.txt").write_text(hdl_revision() + "\n")
     (OUT / "resources.json").write_text(json.dumps(out, indent=2, default=str) + "\n")
     return out
 

@@ -54,6 +54,24 @@ def slug(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_")[:120]
 
 
+def hdl_revision() -> str:
+    """The commit the HDL of a measurement was converted from, for the benches' tables.
+
+    ``+`` follows it when ``hdl/`` or ``tools/models/`` has uncommitted changes (the measured HDL is then
+    not that commit's); ``?`` without git.
+    """
+    import subprocess
+
+    try:
+        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                              text=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "hdl", "tools/models"], cwd=ROOT,
+                               capture_output=True, text=True).stdout.strip()
+    except OSError:
+        return "?"
+    return (head or "?") + ("+" if dirty else "")
+
+
 def simulator(sim: str | None = None) -> str:
     """The simulator to use: ``sim``, else ``$SIM``, else ghdl; ValueError for an unknown one."""
     sim = (sim or os.environ.get("SIM") or "ghdl").strip().lower()
