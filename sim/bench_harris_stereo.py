@@ -51,6 +51,10 @@ PAIRS = {"Tsukuba": ("middlebury/tsukuba/im3.png", "middlebury/tsukuba/im4.png")
          "Venus": ("middlebury/venus/im2.png", "middlebury/venus/im6.png")}
 #: What each share factor runs: (pairs back to back, duty).
 RUNS = {1: (["Tsukuba"], 1.0), 2: (["Venus"], 1.0), 3: (["Tsukuba"], 1.0)}
+#: The stress run of each share factor: a full-size pair of frames cut by a reset token after a left beat
+#: (``token_after`` beats in), then a real pair and a random pair back to back, at a duty cycle.
+RANDOM = "random:7|random:8"
+STRESS = {1: (["Venus", RANDOM], 0.3, 60001), 2: ([RANDOM, "Tsukuba"], 0.7, 120001), 3: (["Tsukuba", RANDOM], 1.0, 150001)}
 
 #: Thesis Table 6.4 (stereo detector, sharing 3, Xilinx ISE on the Spartan-3E 500): LUT, RAMB16, MULT18X18.
 TABLE_6_4 = {"sobel_stereo": (374, 2, 0), "harris_window_stereo": (1818, 8, 1), "cornerness_stereo": (266, 0, 2),
@@ -101,38 +105,58 @@ def sim_entry(share: int, rep: dict, names, duty, wall: float) -> dict:
                 load=round(os.getloadavg()[0], 1), date=str(datetime.date.today()))
 
 
+def pair_images(name: str, shared: Path):
+    """(left, right) of a pair name of PAIRS (centre crops) or a frame spec ``A|B`` of the bench."""
+    if name in PAIRS:
+        return tuple(crop(shared / p) for p in PAIRS[name])
+    from eyestereo.sim.tb_harris_stereo import stereo_pair
+
+    return stereo_pair(name, W, H)
+
+
+def _label(name: str) -> str:
+    return "random" if name == RANDOM else name
+
+
 def model_corners(names, shared: Path) -> list[list[int]]:
     """(left, right) corners inside the specified area per pair, by the model (equal to the VHDL's)."""
     from eyestereo.tools.models import harris_stereo as model
 
     out = []
     for n in names:
-        left, right = (crop(shared / p) for p in PAIRS[n])
+        left, right = pair_images(n, shared)
         fl, fr, mask = model.harris_stereo(left, right, K, THR, blocks=(4, 4), nms=3)
         out.append([int((fl.astype(bool) & mask).sum()), int((fr.astype(bool) & mask).sum())])
     return out
 
 
-def run_sim(shared: Path, shares) -> dict:
+def run_sim(shared: Path, shares, stress: bool = False) -> dict:
+    """The rate runs (RUNS) of ``shares``, or their stress runs (STRESS, keys ``stress N``)."""
     BUILD.mkdir(parents=True, exist_ok=True)
     out = {}
     for share in shares:
-        names, duty = RUNS[share]
+        names, duty, token = STRESS[share] if stress else (*RUNS[share], None)
         frames = []
         for n in names:
-            left, right = (crop(shared / p) for p in PAIRS[n])
+            if n not in PAIRS:
+                frames.append(n)
+                continue
             f = BUILD / f"{n}.npy"
-            np.save(f, np.stack([left, right]))
+            np.save(f, np.stack(pair_images(n, shared)))
             frames.append(f"npy:{f}")
+        cfg = dict(frames=frames, duty=duty, k=K, thresholds=THR, seed=share)
+        if token is not None:
+            cfg.update(token_after=token, token_cam=1)
+        key = f"stress {share}" if stress else share
         t0 = time.perf_counter()
-        rep = run_bench("harris_stereo", "tb_harris_stereo", dict(frames=frames, duty=duty, k=K, thresholds=THR),
-                        name=f"bench_share{share}", params=dict(width=W, height=H, blocks=(4, 4), nms=3, share=share),
+        rep = run_bench("harris_stereo", "tb_harris_stereo", cfg, name=f"bench_{'stress' if stress else 'share'}{share}",
+                        params=dict(width=W, height=H, blocks=(4, 4), nms=3, share=share),
                         build_root=ROOT / "build" / "sim")
         wall = time.perf_counter() - t0
-        out[share] = sim_entry(share, rep, names, duty, wall)
-        out[share]["corners"] = model_corners(names, shared)
-        print(f"share {share}: {names} bit-exact, {rep['pixels_compared']} flags compared, latency {rep['latency']}, "
-              f"{out[share]['clocks']} clocks, {wall:.0f} s", flush=True)
+        out[key] = sim_entry(share, rep, [_label(n) for n in names], duty, wall)
+        out[key].update(corners=model_corners(names, shared), token_after=token, share=share)
+        print(f"{key}: {names} bit-exact, {rep['pixels_compared']} flags compared, latency {rep['latency']}, "
+              f"{out[key]['clocks']} clocks, {wall:.0f} s", flush=True)
     return out
 
 
@@ -211,17 +235,35 @@ def render(sim: dict | None, synth: dict | None) -> str:
     if sim:
         lines += ["Each camera's flags equal the `harris_mono` model of that camera's frame with that camera's k "
                   f"(left code {K[0]}, right {K[1]}) and 16 block thresholds (different per side), on every specified "
-                  "pixel; one pair per share factor at full rate (a beat every `share` clocks; back-to-back pairs, "
-                  "duty cycles and reset tokens are covered by the small-frame regressions, "
-                  "tests/hdl/test_harris_stereo_sim.py); the bench also checks that no valid beat has an "
-                  "undefined bit and nothing is left over.", "",
+                  "pixel; the rate runs below take one pair per share factor at full rate (a beat every `share` "
+                  "clocks); the stress runs after them add back-to-back pairs, random pixels, duty cycles and a "
+                  "reset token (so do the small-frame regressions, tests/hdl/test_harris_stereo_sim.py, with more "
+                  "seeds, NMS sizes and block layouts); the bench also checks that no valid beat has an undefined "
+                  "bit and nothing is left over.", "",
                   "| share | stereo pairs (centre 352x288) | flags compared | corners left / right | GHDL back end, numeric_std | wall time (1-min load at the end) | date | HDL revision |",
                   "|---:|---|---:|---|---|---:|---|---|"]
-        for s, r in sorted(sim.items()):
+        rate = {k: v for k, v in sim.items() if k.isdigit()}
+        stress = {k: v for k, v in sim.items() if k.startswith("stress ")}
+        for s, r in sorted(rate.items()):
             fl = ", ".join(f"{a} / {b}" for a, b in r.get("corners", []))
             lines.append(f"| {s} | {' + '.join(r['pairs'])} | {r['pixels_compared']} | {fl} | "
                          f"{r.get('backend', 'mcode')}, {r.get('ieee', 'standard')} | {r['wall_s']:.0f} s "
                          f"({r.get('load', '?')}) | {r.get('date', '?')} | {r.get('revision', '?')} |")
+        if stress:
+            lines += ["", "Stress runs, full size as well: first a pair of frames cut by a reset token after a left beat "
+                      "(so the token also breaks a pixel pair; one token must come out, before any flag of the "
+                      "frames after it), then pairs back to back (a real one and one of random pixels), at a duty "
+                      "cycle (a beat `share` clocks after the previous one, then each clock with probability `duty`); "
+                      "the same checks, every flag of the complete frames compared.", "",
+                      "| share | token after beat | then pairs, back to back | duty | flags compared | corners left / right | "
+                      "clocks | GHDL back end, numeric_std | wall time (1-min load at the end) | date | HDL revision |",
+                      "|---:|---:|---|---:|---:|---|---:|---|---:|---|---|"]
+            for k, r in sorted(stress.items()):
+                fl = ", ".join(f"{a} / {b}" for a, b in r.get("corners", []))
+                lines.append(f"| {r['share']} | {r['token_after']:,} | {' + '.join(r['pairs'])} | {r['duty']} | "
+                             f"{r['pixels_compared']} | {fl} | {r['clocks']:,} | {r.get('backend', 'mcode')}, "
+                             f"{r.get('ieee', 'standard')} | {r['wall_s']:.0f} s ({r.get('load', '?')}) | "
+                             f"{r.get('date', '?')} | {r.get('revision', '?')} |")
         lines += ["", "## Throughput and latency", "",
                   "Measured in the same runs: beats in per clock from the first beat in to the last flag out (one "
                   "pair, so the latency and the frame's tail are included: the limit is one beat per `share` "
@@ -231,7 +273,7 @@ def render(sim: dict | None, synth: dict | None) -> str:
                   "and equals `harris_stereo.latency(nms, share)`.", "",
                   "| share | multipliers | beats per clock (measured) | stereo pixels per clock | at 50 MHz | latency (clocks after pixel (x+5, y+4)) | = |",
                   "|---:|---:|---:|---:|---|---:|---|"]
-        for s, r in sorted(sim.items()):
+        for s, r in sorted(rate.items()):
             s = int(s)
             bpc = r["beats_per_clock"]
             fps = 50e6 * bpc / (2 * W * H)
@@ -296,12 +338,16 @@ def main(argv=None) -> int:
     ap.add_argument("--shared", type=Path, default=ROOT.parent / "shared" / "data")
     ap.add_argument("--shares", type=int, nargs="*", default=[1, 2, 3])
     ap.add_argument("--no-sim", action="store_true")
+    ap.add_argument("--no-stress", action="store_true", help="only the rate runs (one real pair per share at full rate)")
+    ap.add_argument("--no-rate", action="store_true", help="only the stress runs")
     ap.add_argument("--no-synth", action="store_true")
     ap.add_argument("--stages", nargs="*", default=None, help="synthesize only these stages (default: all five)")
     a = ap.parse_args(argv)
     BUILD.mkdir(parents=True, exist_ok=True)
     if not a.no_sim:
-        new = run_sim(a.shared, a.shares)
+        new = {} if a.no_rate else run_sim(a.shared, a.shares)
+        if not a.no_stress:
+            new.update(run_sim(a.shared, a.shares, stress=True))
         sim = _load("sim") or {}  # read after the runs: other processes may have added shares meanwhile
         sim.update({str(k): v for k, v in new.items()})
         (BUILD / "sim.json").write_text(json.dumps(sim, indent=1))

@@ -35,7 +35,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from eyestereo.sim.runner import BUILD, ROOT, hdl_revision, run_bench, slug
+from eyestereo.sim.runner import BUILD, ROOT, hdl_revision, run_bench, same_hdl_sources, slug
 from eyestereo.tools.io import atomic_write_text
 
 OUT = ROOT / "build" / "bench_rectifier"
@@ -155,12 +155,19 @@ def run_frame(label: str, spec: str, left: np.ndarray, right: np.ndarray, mem: d
     return rep
 
 
+#: Seeds of the further full 352x288 frames with the random-delay memory.
+EXTRA_SEEDS = (5, 6, 7, 8)
+
+
 def frames_to_run(quick: bool) -> list[tuple[str, str, str, dict, int]]:
     runs = [("synthetic rig 352x288, memory at once", "rig", "synthetic", MEMORIES["at once"], 1),
             ("synthetic rig 352x288, random delays", "rig", "synthetic", MEMORIES["random delays"], 2)]
     if not quick:
         runs += [("OpenCV chessboard 640x480, memory at once", "opencv", "opencv", MEMORIES["at once"], 3),
                  ("OpenCV chessboard 640x480, random delays", "opencv", "opencv", MEMORIES["random delays"], 4)]
+        # more seeds of the random memory on full frames (the small-frame regressions run many more)
+        runs += [(f"synthetic rig 352x288, random delays, seed {s}", "rig", "synthetic", MEMORIES["random delays"], s)
+                 for s in EXTRA_SEEDS]
     return runs
 
 
@@ -341,9 +348,11 @@ def report_text(res: dict, rs: list[dict]) -> str:
                      f"{r['wall']:.0f} s | {r.get('revision', '4d75c52')} |")
         revs = sorted({r.get("revision", "4d75c52") for r in fr})
         if len(revs) > 1:
-            L += ["", f"HDL revisions {', '.join(revs)}: between them only the form of `fetch_interpolate`'s reuse test "
-                  "changed (one offset subtraction and an unsigned compare instead of a signed difference, for "
-                  "MyHDL's Verilog back end); the 352x288 frames, run on both, gave identical clocks, reads and (bit-exact) streams."]
+            same = all(same_hdl_sources(revs[0], r) for r in revs[1:])
+            L += ["", f"HDL revisions {', '.join(revs)}: " + (
+                "the same `hdl/` and `tools/models/` sources (`git diff` shows no change there), so the same VHDL."
+                if same else "their HDL sources differ; `python -m eyestereo.sim.vhdl_diff REV rectifier:quantizers=rig` "
+                "(or `=opencv`) says whether the VHDL does.")]
         L.append("")
     if res["remap"]:
         L += ["Hardware images against OpenCV's `remap` (float32 maps, `INTER_LINEAR`) of the same camera images, "

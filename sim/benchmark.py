@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from eyestereo.hdl import synth
-from eyestereo.sim.runner import BUILD, ROOT, build_dir_of, run_bench, simulator_versions, slug
+from eyestereo.sim.runner import BUILD, ROOT, archived_tree, build_dir_of, run_bench, simulator_versions, slug
 from eyestereo.tools.io import atomic_write_text
 
 W, H = 352, 288
@@ -230,24 +230,14 @@ def run_before_commit(case, rev: str = BEFORE_COMMIT) -> dict:
     the test; clocks from the simulated time at its 10 ns clock).
     """
     import os
-    import shutil
     import subprocess
 
     name, block, bench, params, radius, frames = case[:6]
     extra = case[6] if len(case) > 6 else {}
-    root = BUILD.parent / "before" / rev
-    if not (root / ".complete").exists():
-        shutil.rmtree(root, ignore_errors=True)
-        root.mkdir(parents=True)
-        tar = subprocess.run(["git", "-C", str(ROOT), "archive", rev], capture_output=True)
-        if tar.returncode != 0:
-            raise RuntimeError(f"git archive {rev}: {tar.stderr.decode().strip()} (the benchmark needs the history)")
-        subprocess.run(["tar", "-x", "-C", str(root)], input=tar.stdout, check=True)
-        pkg = root / "pkg" / "eyestereo"
-        pkg.mkdir(parents=True)
-        for d in ("hdl", "sim", "tools"):
-            (pkg / d).symlink_to(root / d)
-        (root / ".complete").touch()
+    try:
+        root = archived_tree(rev, BUILD.parent / "before" / rev)
+    except ValueError as e:
+        raise RuntimeError(str(e)) from None
     spec = dict(block=block, bench=bench, params={k: (list(v) if isinstance(v, tuple) else v) for k, v in params.items()},
                 config=dict(extra, frames=frames, duty=1.0))
     env = dict(os.environ, PYTHONPATH=str(root / "pkg"), GHDL_BACKEND="mcode")

@@ -72,6 +72,53 @@ def hdl_revision() -> str:
     return (head or "?") + ("+" if dirty else "")
 
 
+def archived_tree(rev: str, root: Path, *, cache: bool = False) -> Path:
+    """The tree of commit ``rev`` unpacked into ``root`` (``git archive``), importable from ``root/pkg``.
+
+    ``root/pkg/eyestereo`` links the commit's ``hdl``, ``sim`` and ``tools``, so with ``root/pkg`` first on
+    PYTHONPATH ``import eyestereo`` is that commit's package. Unpacked once (``root/.complete``); ValueError
+    when git cannot give the commit. ``cache``: copy today's ``build/cache`` (generated calibrations) in.
+    """
+    import shutil
+    import subprocess
+
+    root = Path(root)
+    if (root / ".complete").exists():
+        return root
+    shutil.rmtree(root, ignore_errors=True)
+    root.mkdir(parents=True)
+    tar = subprocess.run(["git", "-C", str(ROOT), "archive", rev], capture_output=True)
+    if tar.returncode != 0:
+        shutil.rmtree(root, ignore_errors=True)
+        raise ValueError(f"git archive {rev}: {tar.stderr.decode().strip() or 'failed'} (this needs the history)")
+    subprocess.run(["tar", "-x", "-C", str(root)], input=tar.stdout, check=True)
+    pkg = root / "pkg" / "eyestereo"
+    pkg.mkdir(parents=True)
+    for d in ("hdl", "sim", "tools"):
+        (pkg / d).symlink_to(root / d)
+    if cache and (ROOT / "build" / "cache").exists():
+        shutil.copytree(ROOT / "build" / "cache", root / "build" / "cache")
+    (root / ".complete").touch()
+    return root
+
+
+def same_hdl_sources(rev_a: str, rev_b: str) -> bool | None:
+    """Whether two commits have the same ``hdl/`` and ``tools/models/`` (then they convert to the same HDL).
+
+    None when git cannot tell (no history, an unknown commit, a revision marked ``+``).
+    """
+    import subprocess
+
+    if "+" in rev_a + rev_b or "?" in rev_a + rev_b:
+        return None
+    try:
+        r = subprocess.run(["git", "diff", "--quiet", rev_a, rev_b, "--", "hdl", "tools/models"], cwd=ROOT,
+                           capture_output=True)
+    except OSError:
+        return None
+    return {0: True, 1: False}.get(r.returncode)
+
+
 def simulator(sim: str | None = None) -> str:
     """The simulator to use: ``sim``, else ``$SIM``, else ghdl; ValueError for an unknown one."""
     sim = (sim or os.environ.get("SIM") or "ghdl").strip().lower()
