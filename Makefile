@@ -106,8 +106,9 @@ demo: setup
 	$(PY) -m eyestereo.sim.demo --out build/demo
 
 # GHDL's netlist of every block's VHDL -> Yosys (Spartan-3E resources) and nextpnr-ecp5 (fmax per clock);
-# the table goes to build/synth/resources.md and into docs/benchmarks.md's synth section.
-SYNTH_JOBS ?= 1
+# the table goes to build/synth/resources.md and into docs/benchmarks.md's synth section. SYNTH_JOBS
+# configurations at once (Yosys and nextpnr run single-threaded; the results do not depend on it).
+SYNTH_JOBS ?= $(JOBS)
 synth: setup
 	$(PY) -m eyestereo.hdl.synth --out build/synth --doc docs/benchmarks.md --jobs $(SYNTH_JOBS)
 
