@@ -84,8 +84,17 @@ def parse_config(text: str) -> tuple[str, str, dict]:
 
 
 def tree(rev: str) -> Path:
-    """The tree of ``rev`` under build/vhdl_diff/<rev>/, importable, with today's generated calibrations."""
-    return archived_tree(rev, OUT / rev, cache=True)
+    """The tree of ``rev`` under build/vhdl_diff/<commit>/, importable, with today's generated calibrations.
+
+    The folder is named by the commit ``rev`` resolves to, so a moving name (``HEAD``, a branch) never
+    finds an older tree.
+    """
+    r = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--verify", "--quiet", f"{rev}^{{commit}}"],
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        raise ValueError(f"git archive {rev}: not a commit of this repository (a shallow clone lacks the history)")
+    commit = r.stdout.strip()
+    return archived_tree(commit, OUT / commit[:12], cache=True)
 
 
 def convert_at(root: Path | None, configs, out: Path, imports=(), hdl: str = "VHDL") -> dict[str, str | None]:
