@@ -36,7 +36,7 @@ from eyestereo.hdl.harris_window_stereo import harris_window_stereo
 from eyestereo.hdl.nms_stereo import nms_stereo
 from eyestereo.hdl.prethreshold_stereo import prethreshold_stereo
 from eyestereo.hdl.sobel_stereo import sobel_stereo
-from eyestereo.sim.runner import ROOT, hdl_revision, run_bench, same_hdl_sources
+from eyestereo.sim.runner import ROOT, hdl_revision, revision_note, run_bench
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import harris_mono as hm
 from eyestereo.tools.models import harris_window as window_model
@@ -264,13 +264,8 @@ def render(sim: dict | None, synth: dict | None) -> str:
                              f"{r['pixels_compared']} | {fl} | {r['clocks']:,} | {r.get('backend', 'mcode')}, "
                              f"{r.get('ieee', 'standard')} | {r['wall_s']:.0f} s ({r.get('load', '?')}) | "
                              f"{r.get('date', '?')} | {r.get('revision', '?')} |")
-        revs = sorted({r.get("revision", "?") for r in sim.values()})
-        if len(revs) > 1:
-            same = all(same_hdl_sources(revs[0], r) for r in revs[1:])
-            lines += ["", f"HDL revisions {', '.join(revs)}: " + (
-                "the same `hdl/` and `tools/models/` sources (`git diff` shows no change there), so the same VHDL."
-                if same else "their HDL sources differ; `python -m eyestereo.sim.vhdl_diff REV "
-                "harris_stereo:share=N` says whether the VHDL does.")]
+        lines += revision_note((r.get("revision", "?") for r in sim.values()),
+                               "python -m eyestereo.sim.vhdl_diff REV harris_stereo:share=N")
         lines += ["", "## Throughput and latency", "",
                   "Measured in the same runs: beats in per clock from the first beat in to the last flag out (one "
                   "pair, so the latency and the frame's tail are included: the limit is one beat per `share` "

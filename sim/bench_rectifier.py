@@ -35,7 +35,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from eyestereo.sim.runner import BUILD, ROOT, hdl_revision, run_bench, same_hdl_sources, slug
+from eyestereo.sim.runner import BUILD, ROOT, hdl_revision, revision_note, run_bench, slug
 from eyestereo.tools.io import atomic_write_text
 
 OUT = ROOT / "build" / "bench_rectifier"
@@ -346,13 +346,8 @@ def report_text(res: dict, rs: list[dict]) -> str:
                      f"{'yes' if r['bit_exact'] else 'NO'} | {r['clocks_per_pixel']:.3f} | {r['reads_per_output_pixel']:.3f} | "
                      f"{r['reads_per_inrange_pixel']:.3f} | 4 | {100 * r['oor_sides'] / (2 * r['width'] * r['height']):.1f} % | "
                      f"{r['wall']:.0f} s | {r.get('revision', '4d75c52')} |")
-        revs = sorted({r.get("revision", "4d75c52") for r in fr})
-        if len(revs) > 1:
-            same = all(same_hdl_sources(revs[0], r) for r in revs[1:])
-            L += ["", f"HDL revisions {', '.join(revs)}: " + (
-                "the same `hdl/` and `tools/models/` sources (`git diff` shows no change there), so the same VHDL."
-                if same else "their HDL sources differ; `python -m eyestereo.sim.vhdl_diff REV rectifier:quantizers=rig` "
-                "(or `=opencv`) says whether the VHDL does.")]
+        L += revision_note((r.get("revision", "4d75c52") for r in fr),
+                           "python -m eyestereo.sim.vhdl_diff REV rectifier:quantizers=rig")
         L.append("")
     if res["remap"]:
         L += ["Hardware images against OpenCV's `remap` (float32 maps, `INTER_LINEAR`) of the same camera images, "

@@ -119,6 +119,18 @@ def same_hdl_sources(rev_a: str, rev_b: str) -> bool | None:
     return {0: True, 1: False}.get(r.returncode)
 
 
+def revision_note(revs, command: str) -> list[str]:
+    """The lines a measured table adds when its rows name several HDL revisions: whether their HDL sources
+    are the same (git), else the ``vhdl_diff`` ``command`` that tells whether the VHDL differs."""
+    revs = sorted(set(revs))
+    if len(revs) < 2:
+        return []
+    same = all(same_hdl_sources(revs[0], r) for r in revs[1:])
+    return ["", f"HDL revisions {', '.join(revs)}: " + (
+        "the same `hdl/` and `tools/models/` sources (`git diff` shows no change there), so the same VHDL."
+        if same else f"their HDL sources differ; `{command}` says whether the VHDL does.")]
+
+
 def simulator(sim: str | None = None) -> str:
     """The simulator to use: ``sim``, else ``$SIM``, else ghdl; ValueError for an unknown one."""
     sim = (sim or os.environ.get("SIM") or "ghdl").strip().lower()

@@ -119,22 +119,23 @@ def compare(a: Path, b: Path) -> tuple[str, list[str]]:
     fb = sorted(p.name for p in b.iterdir() if p.suffix in (".vhd", ".v"))
     if not fa or fa != fb:
         return "differs", [f"files: {fa} against {fb}"]
-    changed = []
+    changed = []  # (file, "+" or "-", line)
     for name in fa:
         x = [l for l in (a / name).read_text().splitlines() if not _HEADER.match(l)]
         y = [l for l in (b / name).read_text().splitlines() if not _HEADER.match(l)]
-        changed += [f"{name}: {l}" for l in difflib.unified_diff(x, y, n=0, lineterm="")
+        changed += [(name, l[0], l[1:]) for l in difflib.unified_diff(x, y, n=0, lineterm="")
                     if l[:1] in "+-" and not l.startswith(("+++", "---"))]
+    shown = [f"{name}: {sign}{line}" for name, sign, line in changed]
     if not changed:
         return "identical", []
-    if all(re.match(r"^[+-]\s*((--|//).*)?$", l.split(": ", 1)[1]) for l in changed):
-        return "comments only", changed
-    body = [l.split(": ", 1)[1][1:] for l in changed]
-    strip = [_INIT.sub(lambda m: m.group(1) or m.group(2), l) for l in body]
-    plus = sorted(s for s, l in zip(strip, changed) if l.split(": ", 1)[1].startswith("+"))
-    minus = sorted(s for s, l in zip(strip, changed) if l.split(": ", 1)[1].startswith("-"))
-    only_init = all(_INIT.match(l) for l in body) and plus == minus
-    return ("initial values only" if only_init else "differs"), changed
+    if all(re.match(r"^\s*((--|//).*)?$", line) for _, _, line in changed):
+        return "comments only", shown
+    if not all(_INIT.match(line) for _, _, line in changed):
+        return "differs", shown
+    # every changed line is a declaration with an initial value: the same declarations on both sides?
+    decl = {s: sorted(_INIT.sub(lambda m: m.group(1) or m.group(2), line) for _, sign, line in changed if sign == s)
+            for s in "+-"}
+    return ("initial values only" if decl["+"] == decl["-"] else "differs"), shown
 
 
 def main(argv=None) -> int:
