@@ -6,9 +6,9 @@ from myhdl import ConcatSignal, Signal, always, always_comb, always_seq, block, 
 from myhdl._Signal import _Signal
 
 from eyestereo.hdl.axil import AxiLite, check_axil
-from eyestereo.hdl.common.checks import block_error, check_clock, check_frame, check_reset
+from eyestereo.hdl.common.checks import block_error, check_clock, check_reset, checked
 from eyestereo.hdl.sram_bus import HostPort, StatPort, check_bundle
-from eyestereo.tools.regmap import OKAY, REGMAP, SLVERR, WRITABLE, Register, RegisterMap
+from eyestereo.tools.regmap import OKAY, REGMAP, SLVERR, WRITABLE, Register, RegisterMap, check_frame_size
 
 __all__ = ["RegisterPorts", "register_bank", "read_wait", "WINDOW_PORTS"]
 
@@ -287,7 +287,8 @@ def register_bank(clk, rst, bus, regs, arb, fcount, host, *, width: int = 352, h
         host: :class:`~eyestereo.hdl.sram_bus.HostPort` (20 address bits, 16 data bits), to the arbiter.
 
     Parameters:
-        width, height: the frame size the GEOMETRY register reports (2..4096).
+        width, height: the frame size the GEOMETRY register reports (2..4096: the rule
+            :func:`eyestereo.tools.regmap.check_frame_size`, which the bank's model checks too).
 
     Latency (bus clocks, measured on GHDL by the bench): a register write's response is valid 3 clocks
     after its address and data moved (the output ports change at the edge before); a register or window
@@ -315,7 +316,7 @@ def register_bank(clk, rst, bus, regs, arb, fcount, host, *, width: int = 352, h
     mem = regmap.of_kind("memory")[0]
     if len(host.req_addr) != _index_bits(mem.count) or len(host.req_wdata) != 16:
         raise block_error(f"port host needs {_index_bits(mem.count)} address bits and 16 data bits")
-    width, height = check_frame(width, height, min_size=2)
+    width, height = checked(check_frame_size, width, height)
     params = dict(width=width, height=height)
     if {r.port for r in regmap.of_kind("window")} != set(WINDOW_PORTS):
         raise block_error(f"the register map's windows must be {WINDOW_PORTS} (the bank's ports)")

@@ -13,7 +13,13 @@ bit for bit against the numpy chain:
   SecantController on the FCOUNT window, the feature count settling to its target, plotted;
 * **GHDL's speed** on the full-size top (``--ghdl-speed US``: the bench's speed probe, US microseconds
   of simulated time on GHDL_BACKEND=llvm) and, if one has been run (``--ghdl-frame MODE``, hours), the
-  full frame on GHDL.
+  full frame on GHDL;
+* a **real scene with more corners than a list holds** (``--real MODES``, issue 30): a real stereo pair
+  (``--real-pair LEFT RIGHT``, default Middlebury Tsukuba from ../shared/data) resized to ``--real-size``
+  (default 352x288, ``cv2.INTER_AREA`` as the bench's ``files:``), handed to the bench as ``pair`` (.npy),
+  threshold code ``--real-threshold`` (default 16), lists of 255 features: every list is cut (overflow flag
+  in its trailer, ``list_overflows``), bit-exact. Only these runs; their section of ``--out`` is replaced in
+  place (the other sections are left as they are) and kept in build/system/runs/ for later full rewrites.
 
 Measured: the frame period of each mode (sequential: start to start, the host's read-out included, one
 stage after the other; overlapped: the interval between completed frames, the feature list's
@@ -23,18 +29,22 @@ speed. Every run's report is kept in build/system/runs/ (``--reuse`` takes them 
 
     python -m eyestereo.sim.bench_stereo_frontend [--sim verilator] [--size 352x288] [--frames 2]
         [--small 48x32] [--adaptive-frames 16] [--ghdl-speed 200] [--reuse] [--out docs/system.md]
+    python -m eyestereo.sim.bench_stereo_frontend --real sequential,overlapped [--real-frames 1]
+        [--real-pair LEFT RIGHT] [--real-size 352x288] [--real-threshold 16] [--sim verilator] [--reuse]
 """
 
 from __future__ import annotations
 
 import argparse
+import datetime
 import json
+import os
 import sys
 import time
 from pathlib import Path
 
 from eyestereo.sim.cli_system import frame_size
-from eyestereo.sim.runner import ROOT, fastest_simulator, run_bench
+from eyestereo.sim.runner import ROOT, fastest_simulator, hdl_revision, revision_note, run_bench
 from eyestereo.tools.camera import CameraTiming
 from eyestereo.tools.models.sram_arbiter import MASTERS
 
@@ -82,8 +92,8 @@ def run_mode(mode: str, size: str, frames: int, timing: dict, sim: str, reuse: b
     full = tuple(int(v) for v in size.split("x")) == FULL
     # full frames: a threshold leaving at most 200 features per camera (the lists hold 255)
     rep = run_bench("stereo_frontend", "tb_stereo_frontend",
-                    dict(dict(mode=mode, frames=frames, images="shift:3", timing=timing, target=200 if full else 40),
-                         **extra),
+                    dict(dict(mode=mode, frames=frames, images="shift:3", timing=timing, target=200 if full else 40,
+                              require_features=not extra.get("speed_us")), **extra),
                     name=f"bench_{mode}_{size}" + ("_speed" if extra.get("speed_us") else ""), sim=sim,
                     backend=backend, params=dict(quantizers=f"rig:{size}", feature_words=512, max_features=255),
                     log_file=RUNS / f"{tag}.log", public=PUBLIC if sim == "verilator" else None)
@@ -178,7 +188,7 @@ def run_adaptive(frames: int, size: str, sim: str, reuse: bool) -> dict:
     # the initial thresholds leave at most 8 features per camera: the loop has to pull the count up
     rep = run_bench("stereo_frontend", "tb_stereo_frontend",
                     dict(mode="sequential", frames=frames, images="shift:3", adaptive=ADAPTIVE_TARGET, target=8,
-                         timing=dict(SHORT, h_blank=8)),
+                         timing=dict(SHORT, h_blank=8), require_features=True),
                     name=f"bench_adaptive_{size}", sim=sim,
                     params=dict(quantizers=f"rig:{size}", feature_words=512, max_features=255),
                     log_file=RUNS / f"{tag}.log", public=PUBLIC if sim == "verilator" else None)
@@ -243,6 +253,165 @@ def adaptive_section(rep: dict, img: Path) -> list[str]:
             f"![adaptive](img/system/{img.name})", "",
             "| frame | camera frame captured | features left | features right | threshold codes left | right |",
             "|---:|---:|---:|---:|---:|---:|", *rows, ""]
+
+
+# --- a real scene with more corners than a list holds (issue 30) ------------------------------------
+SHARED = ROOT.parent / "shared" / "data" / "middlebury"
+REAL_PAIR = (SHARED / "tsukuba" / "im3.png", SHARED / "tsukuba" / "im4.png")
+REAL_THRESHOLD = 16       # threshold code of every block: several hundred corners per frame in Tsukuba
+REAL_MAX_FEATURES = 255   # the lists of the full-frame runs (feature_words 512)
+REAL_TITLE = "## A real scene with more corners than a list holds"
+
+
+def real_pair_arrays(files, size: str):
+    """The Y planes (uint8, the camera size) of a real stereo pair: the library's image-input rule
+    (``read_image`` grey, ``to_grey8`` on the pair), resized with ``cv2.INTER_AREA`` as the bench's ``files:``."""
+    import cv2
+
+    from eyestereo.tools.io import read_image, to_grey8
+
+    w, h = (int(v) for v in size.split("x"))
+    imgs = to_grey8([read_image(f, grey=True) for f in files], [str(f) for f in files])
+    return [cv2.resize(img, (w, h), interpolation=cv2.INTER_AREA) for img in imgs]
+
+
+def real_model(left, right, size: str, threshold: int, max_features: int) -> dict:
+    """What the model finds in the pair (the bench's chain and parameters): per camera totals, listed, overflow."""
+    from eyestereo.hdl.poly_unit import calibration_param
+    from eyestereo.sim.tb_stereo_frontend import model_params
+    from eyestereo.tools.camera import yuv_frame
+    from eyestereo.tools.models import stereo_frontend as model
+    from eyestereo.tools.models.harris_mono import k_code
+
+    cal = calibration_param(f"rig:{size}", None, None)
+    m = model.stereo_frontend(cal, yuv_frame(left), yuv_frame(right), k_code(0.04), [threshold] * 16,
+                              **model_params(dict(max_features=max_features)))["list"]
+    return dict(totals=[int(v) for v in m["totals"]], listed=len(m["features"]), overflow=bool(m["overflow"]))
+
+
+def uncommitted_hdl() -> list[str]:
+    """The files of ``hdl/`` and ``tools/models/`` with uncommitted changes (what a ``+`` after the revision
+    stands for; ``git status``, read only)."""
+    import subprocess
+
+    try:
+        out = subprocess.run(["git", "status", "--porcelain", "hdl", "tools/models"], cwd=ROOT, capture_output=True,
+                             text=True).stdout
+    except OSError:
+        return []
+    return sorted(line[3:].strip() for line in out.splitlines() if line.strip())
+
+
+def run_real(mode: str, size: str, frames: int, sim: str, *, files=REAL_PAIR, threshold: int = REAL_THRESHOLD,
+             reuse: bool = False) -> dict:
+    """One bench run of a real stereo pair (every camera frame the same pair, handed as ``pair`` .npy files),
+    lists of :data:`REAL_MAX_FEATURES`; the report kept in build/system/runs/ with the date, the HDL's
+    revision, the simulator, the wall time and the model's features of the pair."""
+    import numpy as np
+
+    tag = f"{sim}_real_{mode}_{size}"
+    kept = _kept(tag)
+    if reuse and kept.is_file():
+        rep = json.loads(kept.read_text())
+        if len(rep.get("frames", [])) == frames:
+            return rep
+    RUNS.mkdir(parents=True, exist_ok=True)
+    left, right = real_pair_arrays(files, size)
+    pair = [RUNS / f"real_{size}_left.npy", RUNS / f"real_{size}_right.npy"]
+    np.save(pair[0], left)
+    np.save(pair[1], right)
+    found = real_model(left, right, size, threshold, REAL_MAX_FEATURES)
+    print(f"[bench] {tag}: {frames} frame(s) on {sim_label(sim)}; the model finds {found['totals']} corners "
+          f"(left, right), lists {found['listed']}, overflow {found['overflow']} ...", flush=True)
+    revision, dirty, t0 = hdl_revision(), uncommitted_hdl(), time.time()
+    rep = run_bench("stereo_frontend", "tb_stereo_frontend",
+                    dict(mode=mode, frames=frames, pair=[str(f) for f in pair], threshold=threshold,
+                         timing=timing_of(size), require_features=True),
+                    name=f"bench_real_{mode}_{size}", sim=sim,
+                    params=dict(quantizers=f"rig:{size}", feature_words=2 * REAL_MAX_FEATURES + 2,
+                                max_features=REAL_MAX_FEATURES),
+                    log_file=RUNS / f"{tag}.log", public=PUBLIC if sim == "verilator" else None)
+    rep.update(wall_s=round(time.time() - t0, 1), simulator=sim_label(sim), revision=revision, uncommitted=dirty,
+               date=datetime.date.today().isoformat(), size=size, model=found, threshold_code=threshold,
+               files=[os.path.relpath(Path(f).resolve(), ROOT) for f in files])
+    rep.pop("last", None)
+    kept.write_text(json.dumps(rep) + "\n")
+    print(f"[bench] {tag}: done in {rep['wall_s']} s", flush=True)
+    return rep
+
+
+def kept_real(size: str = "352x288") -> list[dict]:
+    """The real-scene runs kept in build/system/runs/ (sequential first)."""
+    order = {"sequential": 0, "overlapped": 1}
+    reps = [json.loads(f.read_text()) for f in sorted(RUNS.glob(f"*_real_*_{size}.json"))]
+    return sorted(reps, key=lambda r: (order.get(r["mode"], 2), r.get("simulator", "")))
+
+
+def real_section(reps: list[dict]) -> list[str]:
+    """The section of the real-scene runs: what the model finds, what the host read back."""
+    if not reps:
+        return []
+    r0 = reps[0]
+    m = r0["model"]
+    mp = r0.get("model_params", {})
+    out = [REAL_TITLE, "",
+           f"Issue 30: a real stereo pair, {' and '.join(f'`{f}`' for f in r0['files'])}, resized to {r0['size']} "
+           "(`cv2.INTER_AREA`), the same pair in every camera frame (the bench's `pair` of .npy files), every "
+           f"threshold block at code {r0['threshold_code']}: the model finds **{m['totals'][0]} + {m['totals'][1]} = "
+           f"{sum(m['totals'])} corners** a frame (left + right), " +
+           (f"more than a list holds (`max_features` {mp.get('max_features', REAL_MAX_FEATURES)}): each list holds "
+            f"the first {m['listed']} in stream order and its trailer's overflow flag is set; the FEATURES and FCOUNT "
+            "registers count them all." if m["overflow"] else
+            f"which a list of {mp.get('max_features', REAL_MAX_FEATURES)} holds (no overflow: lower the threshold "
+            "for the case of the title).") +
+           f" The bench hands the model the top's parameters (`nms` {mp.get('nms')}, `border` " +
+           (f"{mp['border']}" if mp.get("border") is not None else
+            f"{3 + mp.get('nms', 3) // 2} (the top's default, 3 + nms // 2)") +
+           f", `max_features` {mp.get('max_features')}) and checks every rectified pair and list read back bit for "
+           "bit, trailer "
+           "included, and `list_overflows` (OVERFLOWS: the completed frames whose list was cut) against the "
+           "model's count. Before the fix the bench ran the model with its own 1023 features per list and failed "
+           "on such a scene (\"no stereo pair of the frames sent gives what the host read\").", "",
+           "| date | HDL commit | simulator | mode | frames read (done) | features per frame, model: left + right = "
+           "total (listed) | overflow flag read back | list_overflows (expected) | bit-exact | wall |",
+           "|---|---|---|---|---:|---|---|---:|---|---:|"]
+    for r in reps:
+        fr = r["frames"]
+        feats = "; ".join(f"{f['model_totals'][0]} + {f['model_totals'][1]} = {sum(f['model_totals'])} "
+                          f"({f['features']})" for f in fr)
+        flags = ", ".join("set" if f["overflow"] else "clear" for f in fr)
+        lo = r.get("list_overflows") or {}
+        exp = lo.get("expected", ["?", "?"])
+        exp_s = str(exp[0]) if exp[0] == exp[1] else f"{exp[0]}..{exp[1]}"
+        out.append(f"| {r['date']} | {r['revision']} | {r['simulator']} | {r['mode']} | {len(fr)} "
+                   f"({r['frames_done']}) | {feats} | {flags} | {lo.get('counted', '?')} ({exp_s}) | "
+                   f"{'yes' if r['bit_exact'] else 'no'} | {r['wall_s']:.0f} s ({r['wall_s'] / 60:.1f} min) |")
+    revs = sorted({r["revision"] for r in reps})
+    if any("+" in v for v in revs):
+        files = sorted({f for r in reps for f in r.get("uncommitted", [])})
+        out += ["", "A commit marked `+`: `hdl/` or `tools/models/` had uncommitted changes when the run was "
+                "converted (the checkout is shared with other work in progress), so the measured HDL is that commit's "
+                "with those changes" + (f" ({', '.join(f'`{f}`' for f in files)})" if files else "") + "."]
+    out += revision_note((r["revision"] for r in reps if "+" not in r["revision"]),
+                         "python -m eyestereo.sim.vhdl_diff REV stereo_frontend")
+    out += ["", "Run again with `python -m eyestereo.sim.bench_stereo_frontend --real sequential,overlapped` (wall "
+            "time includes the Verilator build of the top; one simulation at a time on a 2-core machine shared with "
+            "other jobs).", ""]
+    return out
+
+
+def splice_section(path: Path, section: list[str], title: str = REAL_TITLE, before: str = "## On GHDL") -> None:
+    """Replace the section ``title`` of the document at ``path`` (up to the next ``## `` heading) with
+    ``section``, or insert it before the heading ``before`` (at the end when there is none)."""
+    lines = path.read_text().splitlines() if path.is_file() else []
+    if title in lines:
+        i = lines.index(title)
+        j = next((k for k in range(i + 1, len(lines)) if lines[k].startswith("## ")), len(lines))
+    else:
+        i = j = next((k for k, v in enumerate(lines) if v.startswith(before)), len(lines))
+    new = lines[:i] + section + lines[j:]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("\n".join(new) + "\n")
 
 
 # --- the document ----------------------------------------------------------------------------------
@@ -459,6 +628,7 @@ def write_doc(path: Path, *, size: str, figs: dict, small: tuple | None, ghdl: t
     lines += full_section(size, figs)
     if small is not None:
         lines += small_section(*small, measured=figs if size == "352x288" else None)
+    lines += real_section(kept_real())
     lines += ghdl_section(*ghdl, figs)
     lines += resources_section()
     lines += demo_section()
@@ -515,6 +685,33 @@ def _size(text: str) -> str:
     return "{}x{}".format(*frame_size(text))
 
 
+def main_real(args) -> int:
+    """``--real``: the real-scene runs alone, their section spliced into ``--out``."""
+    modes = [m.strip() for m in args.real.split(",") if m.strip()]
+    if not modes or any(m not in ("sequential", "overlapped") for m in modes):
+        print(f"error: --real: sequential and/or overlapped, got {args.real!r}", file=sys.stderr)
+        return 1
+    if args.real_frames < 1:
+        print("error: --real-frames must be at least 1", file=sys.stderr)
+        return 1
+    sim = args.sim or fastest_simulator()
+    try:
+        reps = [run_real(m, args.real_size, args.real_frames, sim, files=args.real_pair,
+                         threshold=args.real_threshold, reuse=args.reuse) for m in modes]
+    except ValueError as e:  # an unreadable image
+        print(f"error: {e}", file=sys.stderr)
+        return 1
+    except (AssertionError, RuntimeError) as e:
+        print(f"error: a bench run failed ({str(e).splitlines()[0][:200]})", file=sys.stderr)
+        return 1
+    # the document: every kept real-scene run of this size (a mode run earlier stays in its row)
+    kept = kept_real(args.real_size)
+    splice_section(args.out, real_section(kept or reps))
+    print(json.dumps([dict(mode=r["mode"], frames=len(r["frames"]), bit_exact=r["bit_exact"], model=r["model"],
+                           list_overflows=r.get("list_overflows"), wall_s=r["wall_s"]) for r in reps]))
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sim", choices=("verilator", "icarus", "ghdl"), default=None,
@@ -533,8 +730,19 @@ def main(argv=None) -> int:
                     help="measure GHDL's (llvm) speed on the full-size top over US microseconds of simulated time")
     ap.add_argument("--ghdl-frame", choices=("sequential", "overlapped"),
                     help="also run one full frame on GHDL (llvm): hours")
+    ap.add_argument("--real", metavar="MODES",
+                    help="only the real scene with more corners than a list holds (issue 30): these modes "
+                         "(sequential, overlapped, comma-separated); its section of --out is replaced in place")
+    ap.add_argument("--real-frames", type=int, default=1, help="host frames of each real-scene run (default 1)")
+    ap.add_argument("--real-pair", nargs=2, type=Path, metavar=("LEFT", "RIGHT"), default=list(REAL_PAIR),
+                    help="the real stereo pair (default Middlebury Tsukuba im3, im4 from ../shared/data)")
+    ap.add_argument("--real-size", type=_size, default="352x288")
+    ap.add_argument("--real-threshold", type=int, default=REAL_THRESHOLD,
+                    help=f"threshold code of every block (default {REAL_THRESHOLD})")
     ap.add_argument("--reuse", action="store_true", help="take the runs' reports from build/system/runs/ if there")
     args = ap.parse_args(argv)
+    if args.real is not None:
+        return main_real(args)
     if args.frames < 1 or args.frames_ovl < 1:
         print("error: --frames and --frames-ovl must be at least 1", file=sys.stderr)
         return 1

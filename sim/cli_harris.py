@@ -1,29 +1,31 @@
-"""``eyestereo sim harris``: the stereo Harris VHDL in GHDL on an image pair (added by ``eyestereo.sim.cli``).
+"""``eyestereo sim harris``: the stereo Harris HDL in a simulator on an image pair (added by ``eyestereo.sim.cli``).
 
-``eyestereo sim harris LEFT RIGHT -o OUT``: the generated ``harris_stereo`` VHDL in GHDL on a stereo pair
-of grey images of any size (5..4096 pixels a side); writes ``OUT/corners.json``
-(``{"left": [[x, y], ...], "right": [...]}``: the flags outside the detector's unspecified border, raster
-order) and ``OUT/left.png``, ``OUT/right.png`` (each image with its corners marked). Options: k and the
-block thresholds (in :func:`eyestereo.tools.models.harris_mono.harris_float` units), globally or per
-camera, per block as a comma list of BX*BY values; NMS size; share factor. Errors: one line, exit status
-1 (bad input) or 2 (bad command line), nothing written (the output folder appears whole or not at all).
+``eyestereo sim harris LEFT RIGHT -o OUT``: the generated ``harris_stereo`` on a stereo pair of images of
+any size (5..4096 pixels a side), read by the library's one image rule (colour to grey, 16-bit to its 8
+most significant used bits, floating point refused: :func:`eyestereo.sim.cli_rectify.read_pair`); the
+VHDL in GHDL by default, MyHDL's Verilog in Icarus or Verilator with ``--sim`` (or ``$SIM``), the summary
+line naming the one that ran. Writes ``OUT/corners.json`` (``{"left": [[x, y], ...], "right": [...]}``:
+the flags outside the detector's unspecified border, raster order) and ``OUT/left.png``, ``OUT/right.png``
+(each image with its corners marked). Options: k and the block thresholds (in
+:func:`eyestereo.tools.models.harris_mono.harris_float` units), globally or per camera, per block as a
+comma list of BX*BY values; NMS size; share factor; ``--build-dir``. Errors: one line, exit status 1
+(bad input) or 2 (bad command line), checked before the build; nothing written (the output folder appears
+whole or not at all, and never replaces a folder holding the inputs); SIGINT/SIGTERM stop the simulator
+within a second or two (:mod:`eyestereo.sim.job`).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import shutil
-import tempfile
-import threading
-import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from eyestereo.sim.cli_rectify import add_build_dir
 from eyestereo.tools.cli.common import number
-from eyestereo.tools.io import Outputs, read_image
+from eyestereo.tools.io import Outputs
 from eyestereo.tools.progress import progress_bar
 
 PICTURES = ("corners.json", "left.png", "right.png")
@@ -72,6 +74,9 @@ def add_harris(sub: Any) -> None:
     p.add_argument("--nms", type=int, choices=(1, 3, 5), default=3, help="non-maximum suppression (default 3)")
     p.add_argument("--share", type=int, choices=(1, 2, 3), default=3,
                    help="clocks the multipliers are shared over (default 3, the thesis's design)")
+    p.add_argument("--sim", choices=("ghdl", "icarus", "verilator"), default=None,
+                   help="simulator: ghdl (the VHDL; default, or $SIM), icarus or verilator (MyHDL's Verilog)")
+    add_build_dir(p)
     p.set_defaults(func=cmd_harris)
 
 
@@ -97,85 +102,64 @@ def _overlay(img: np.ndarray, pts: list) -> np.ndarray:
 def cmd_harris(args: argparse.Namespace) -> int:
     import cv2
 
-    from eyestereo.tools.models.harris_mono import features, k_code, radius
+    from eyestereo.sim.cli_rectify import read_pair
+    from eyestereo.sim.job import check_build_dir, run_folder
+    from eyestereo.sim.runner import check_simulator, describe
     from eyestereo.tools.models.border import interior_mask
+    from eyestereo.tools.models.harris_mono import features, k_code, radius
 
+    # every input checked before anything is built
+    left, right = read_pair(args.left, args.right)
+    h, w = left.shape
+    r = radius(args.nms)
+    if min(w, h) < max(5, 2 * r + 1) or max(w, h) > 4096:
+        raise ValueError(f"the images are {w}x{h}: harris_stereo takes {2 * r + 1}..4096 pixels a side "
+                         f"(nms {args.nms})")
+    bx, by = args.blocks
+    if bx > w or by > h:
+        raise ValueError(f"--blocks {bx}x{by} is more than the image's {w}x{h} pixels")
+    n = bx * by
+    k = [k_code(args.k if args.k_left is None else args.k_left), k_code(args.k if args.k_right is None else args.k_right)]
+    thr = [_per_block(args.threshold if args.threshold_left is None else args.threshold_left, n, "--threshold-left"
+                      if args.threshold_left is not None else "--threshold"),
+           _per_block(args.threshold if args.threshold_right is None else args.threshold_right, n, "--threshold-right"
+                      if args.threshold_right is not None else "--threshold")]
+    sim = check_simulator(args.sim)
+    check_build_dir(args.build_dir)
+    what = describe(sim)
     with Outputs() as out:
-        folder = out.folder(args.output, PICTURES)
-        left = read_image(args.left, what="left image", grey=True)
-        right = read_image(args.right, what="right image", grey=True)
-        for name, img in (("left", left), ("right", right)):
-            if img.dtype != np.uint8:
-                raise ValueError(f"{name} image {getattr(args, name)} is {img.dtype}, not 8-bit grey")
-        if left.shape != right.shape:
-            raise ValueError(f"the images differ in size: left {left.shape[1]}x{left.shape[0]}, "
-                             f"right {right.shape[1]}x{right.shape[0]}")
-        h, w = left.shape
-        r = radius(args.nms)
-        if min(w, h) < max(5, 2 * r + 1) or max(w, h) > 4096:
-            raise ValueError(f"the images are {w}x{h}: harris_stereo takes {2 * r + 1}..4096 pixels a side "
-                             f"(nms {args.nms})")
-        bx, by = args.blocks
-        if bx > w or by > h:
-            raise ValueError(f"--blocks {bx}x{by} is more than the image's {w}x{h} pixels")
-        n = bx * by
-        k = [k_code(args.k if args.k_left is None else args.k_left), k_code(args.k if args.k_right is None else args.k_right)]
-        thr = [_per_block(args.threshold if args.threshold_left is None else args.threshold_left, n, "--threshold-left"
-                          if args.threshold_left is not None else "--threshold"),
-               _per_block(args.threshold if args.threshold_right is None else args.threshold_right, n, "--threshold-right"
-                          if args.threshold_right is not None else "--threshold")]
-        if shutil.which("ghdl") is None:
-            raise ValueError("ghdl not found: install it (Debian: apt-get install ghdl)")
-        flags = _simulate(left, right, k, thr, blocks=(bx, by), nms=args.nms, share=args.share)
+        folder = out.folder(args.output, PICTURES, inputs=[args.left, args.right])
+        with run_folder("sim-harris", args.build_dir) as work:
+            flags = _simulate(left, right, k, thr, blocks=(bx, by), nms=args.nms, share=args.share, sim=sim,
+                              work=work, what=what)
         mask = interior_mask(h, w, r)
         pts = {side: features(flags[i], mask).tolist() for i, side in enumerate(("left", "right"))}
         (folder / "corners.json").write_text(json.dumps(pts) + "\n")
-        for i, (side, img) in enumerate((("left", left), ("right", right))):
+        for side, img in (("left", left), ("right", right)):
             if not cv2.imwrite(str(folder / f"{side}.png"), _overlay(img, pts[side])):
                 raise ValueError(f"cannot write {side}.png")
     print(f"corners: {len(pts['left'])} left, {len(pts['right'])} right ({w}x{h}, k codes {k[0]}/{k[1]}, "
-          f"{bx}x{by} blocks, nms {args.nms}, share {args.share}; harris_stereo VHDL in GHDL)")
+          f"{bx}x{by} blocks, nms {args.nms}, share {args.share}; harris_stereo, {what})")
     print(f"-> {args.output / 'corners.json'}, left.png, right.png")
     return 0
 
 
-def _simulate(left, right, k, thr, *, blocks, nms, share) -> np.ndarray:
-    """(2, H, W) flags of the pair from the generated VHDL (a temporary build folder, removed after)."""
-    from eyestereo.sim.runner import run_bench
+def _simulate(left, right, k, thr, *, blocks, nms, share, sim, work: Path, what: str) -> np.ndarray:
+    """(2, H, W) flags of the pair from the generated HDL, built and run in ``work`` by a child process
+    (:func:`eyestereo.sim.job.run_job`: a signal stops it at once)."""
+    from eyestereo.sim.job import file_progress, run_job
 
     h, w = left.shape
-    tmp = Path(tempfile.mkdtemp(prefix="eyestereo-sim-harris-"))
-    try:
-        np.save(tmp / "pair.npy", np.stack([left, right]).astype(np.int64))
-        prog = tmp / "progress"
-        prog.write_text("0")
-        cfg = dict(input=str(tmp / "pair.npy"), output=str(tmp / "flags.npy"), progress=str(prog), k=k,
-                   thresholds=thr)
-        err: list[BaseException] = []
-
-        def work():
-            try:
-                run_bench("harris_stereo", "tb_harris_cli", cfg, name="run", build_root=tmp / "build", log_file=tmp / "sim.log",
-                          params=dict(width=w, height=h, blocks=blocks, nms=nms, share=share))
-            except BaseException as e:  # noqa: BLE001 - reported in the main thread
-                err.append(e)
-
-        t = threading.Thread(target=work, daemon=True)
-        total = 2 * w * h
-        with progress_bar(total, "harris_stereo in GHDL") as bar:
-            t.start()
-            done = 0
-            while t.is_alive():
-                t.join(0.5)
-                try:
-                    now = int(prog.read_text() or 0)
-                except (OSError, ValueError):
-                    continue
-                bar.update(max(0, now - done))
-                done = max(done, now)
-        if err:
-            raise ValueError(f"the GHDL simulation failed ({type(err[0]).__name__}: "
-                             f"{str(err[0]).splitlines()[0] if str(err[0]) else ''})")
-        return np.load(tmp / "flags.npy")
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+    np.save(work / "pair.npy", np.stack([left, right]).astype(np.int64))
+    prog = work / "progress"
+    prog.write_text("0")
+    cfg = dict(input=str(work / "pair.npy"), output=str(work / "flags.npy"), progress=str(prog), k=k,
+               thresholds=thr)
+    total = 2 * w * h
+    with progress_bar(total, f"harris_stereo ({sim})") as bar:
+        run_job("eyestereo.sim.runner:run_bench",
+                dict(block="harris_stereo", bench="tb_harris_cli", config=cfg, name="run", build_root=work / "build",
+                     log_file=work / "sim.log", sim=sim,
+                     params=dict(width=w, height=h, blocks=list(blocks), nms=nms, share=share)),
+                work, progress=file_progress(prog, bar, total), what=f"the simulation ({what})")
+    return np.load(work / "flags.npy")

@@ -1,33 +1,47 @@
-"""``eyestereo sim system``: the complete front end's VHDL in GHDL on a stereo pair (added by ``eyestereo.sim.cli``).
+"""``eyestereo sim system``: the complete front end in a simulator on a stereo pair (added by ``eyestereo.sim.cli``).
 
-``eyestereo sim system LEFT RIGHT -o OUT [--json FILE]``: both images, resized to the camera size
-(``--size``, default 48x32, with the synthetic rig's calibration of that size), are played by two camera
-models (18 and 17.9 MHz) through the whole stereo_frontend (SRAM model, rectifier, stereo Harris, feature
-lists) in both modes (``--modes``); the host driver reads every frame back over AXI4-Lite and compares it
-with the numpy chain. Writes ``OUT/rectified.png`` (the rectified pair side by side with row lines and
-the corners), ``OUT/matches.png`` (the host's feature lists matched by the matching package, coloured by
-disparity) and ``OUT/summary.json``; ``--json FILE`` the same figures (frames, fps per mode, SRAM share
-per master, bit_exact). A one-screen summary on stdout. Small frames keep it to a few minutes on 2 cores
-(GHDL runs the system at a few thousand clocks per second). Errors: one line, exit status 1, nothing
-written.
+``eyestereo sim system LEFT RIGHT -o OUT [--json FILE]``: both images, read by the library's one image rule
+(:func:`eyestereo.sim.cli_rectify.read_pair`: colour to grey, 16-bit to its 8 most significant used bits,
+floating point refused) and resized to the camera size (``--size``, default 48x32, with the synthetic
+rig's calibration of that size), are played by two camera models (18 and 17.9 MHz) through the whole
+stereo_frontend (SRAM model, rectifier, stereo Harris, feature lists) in both modes (``--modes``); the
+host driver reads every frame back over AXI4-Lite and compares it with the numpy chain. Writes
+``OUT/rectified.png`` (the rectified pair side by side with row lines and the corners), ``OUT/matches.png``
+(the host's feature lists matched by the matching package, coloured by disparity) and
+``OUT/summary.json``; ``--json FILE`` the same figures (frames, fps per mode, SRAM share per master,
+bit_exact). A one-screen summary on stdout. Small frames keep it to a few minutes on 2 cores (GHDL runs
+the system at a few thousand clocks per second); ``--frames`` is 1..64 per mode.
+
+Every input is checked before the build (images, sizes, the simulator, the bench's packages, the output
+places); outputs are written all or nothing (``OUT`` and ``--json`` together), ``OUT`` new, empty or
+holding only this command's files, never a folder holding the inputs; the simulations run in child
+processes (:mod:`eyestereo.sim.job`) that SIGINT/SIGTERM stop within a second or two, built in a fresh
+folder under ``--build-dir`` (default ``$EYESTEREO_BUILD_DIR``, else the system's temporary folder), so
+two runs at once never collide. Errors: one line, exit status 1 (bad input) or 2 (bad command line).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import shutil
-import sys
-import tempfile
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from eyestereo.sim.cli_rectify import add_build_dir
+from eyestereo.tools.cli.common import integer
 from eyestereo.tools.models.sram_arbiter import MASTERS
 
 MODES = ("sequential", "overlapped")
+#: Stereo frames the host reads per mode, at most (each costs a camera frame and more of simulation).
+MAX_FRAMES = 64
+#: What the command writes into OUT.
+OWNED = ("rectified.png", "matches.png", "summary.json")
+#: The camera timing of the command's runs (a short blanking: the small frames go fast).
+TIMING = dict(h_blank=64, v_sync=1, v_back=1, v_front=1)
+#: The bench's Python packages beyond the library's own (named in the error when one is missing).
+BENCH_PACKAGES = {"cocotbext.axi": "cocotbext-axi"}
 
 
 def frame_size(text: str) -> tuple[int, int]:
@@ -41,19 +55,31 @@ def frame_size(text: str) -> tuple[int, int]:
     return w, h
 
 
+def modes_list(text: str) -> list[str]:
+    """``--modes``: a comma list of :data:`MODES` (argparse type)."""
+    modes = [m.strip() for m in text.split(",") if m.strip()]
+    bad = [m for m in modes if m not in MODES]
+    if bad or not modes:
+        raise argparse.ArgumentTypeError(f"choose from {', '.join(MODES)} (a comma list), got {text!r}")
+    return list(dict.fromkeys(modes))
+
+
 def add_system(sub: Any) -> None:
     """Add ``sim system`` to the ``sim`` group's subparsers (``eyestereo.sim.cli.register`` calls it)."""
     p = sub.add_parser("system", help="the complete front end (cameras -> SRAM -> rectifier -> Harris -> lists) "
-                       "in GHDL on a stereo pair", description=__doc__.splitlines()[0])
+                       "in a simulator on a stereo pair", description=__doc__.splitlines()[0])
     p.add_argument("left", type=Path, help="left camera image (resized to --size)")
-    p.add_argument("right", type=Path, help="right camera image")
-    p.add_argument("-o", "--output", type=Path, required=True, help="folder for rectified.png and summary.json")
-    p.add_argument("--json", type=Path, help="also write the figures to this file")
+    p.add_argument("right", type=Path, help="right camera image, the same size")
+    p.add_argument("-o", "--output", type=Path, required=True,
+                   help="folder for rectified.png, matches.png, summary.json: new, empty, or holding only these")
+    p.add_argument("--json", type=Path, help="also write the figures to this file (outside OUT)")
     p.add_argument("--size", type=frame_size, default=(48, 32), help="camera size WxH (default 48x32)")
-    p.add_argument("--frames", type=int, default=2, help="stereo frames the host reads per mode (default 2)")
-    p.add_argument("--modes", default="sequential,overlapped", help="comma list of modes (default both)")
+    p.add_argument("--frames", type=integer(1, MAX_FRAMES, "--frames"), default=2,
+                   help=f"stereo frames the host reads per mode, 1..{MAX_FRAMES} (default 2)")
+    p.add_argument("--modes", type=modes_list, default=list(MODES), help="comma list of modes (default both)")
     p.add_argument("--sim", choices=("ghdl", "icarus", "verilator"), default=None,
                    help="simulator (default: the fastest here: Verilator on MyHDL's Verilog if installed, else GHDL)")
+    add_build_dir(p)
     p.set_defaults(func=cmd_sim_system)
 
 
@@ -70,7 +96,8 @@ def _picture(rect: np.ndarray, features, path: Path) -> None:
         cv2.line(img, (0, y), (2 * w * s - 1, y), (0, 160, 0), 1)
     for x, y, cam in features:
         cv2.circle(img, ((x + cam * w) * s + s // 2, y * s + s // 2), max(2, s), (0, 0, 255), 1)
-    cv2.imwrite(str(path), img)
+    if not cv2.imwrite(str(path), img):
+        raise ValueError(f"cannot write {path.name}")
 
 
 def _matches_picture(rect: np.ndarray, features, path: Path) -> dict:
@@ -112,89 +139,113 @@ def _matches_picture(rect: np.ndarray, features, path: Path) -> dict:
         cv2.circle(img, pl, max(3, s), c, -1)
     bar = cv2.applyColorMap(np.tile(np.linspace(0, 255, w * s).astype(np.uint8), (12, 1)), cv2.COLORMAP_JET)
     cv2.putText(bar, f"d = 0 .. {d_hi}", (4, 10), cv2.FONT_HERSHEY_SIMPLEX, 0.35, (255, 255, 255), 1)
-    cv2.imwrite(str(path), np.vstack([img, bar]))
+    if not cv2.imwrite(str(path), np.vstack([img, bar])):
+        raise ValueError(f"cannot write {path.name}")
     return dict(corners=[len(fl), len(fr)], matches=int(len(disp)),
                 disparity=[int(disp.min()), int(disp.max())] if len(disp) else None)
 
 
-def main_system(left: Path, right: Path, output: Path, *, size=(48, 32), frames: int = 2,
-                modes=("sequential", "overlapped"), sim: str | None = None) -> dict:
-    """Run the system (see the module doc) and write OUTPUT/; returns the summary. Raises AssertionError
-    when the simulation fails."""
-    from eyestereo.sim.bench_stereo_frontend import PUBLIC, figures, sim_label
-    from eyestereo.sim.runner import fastest_simulator, run_bench
-    from eyestereo.tools.camera import CameraTiming
+def check_bench_packages() -> None:
+    """ValueError naming the package to install when one the system bench needs is missing."""
+    import importlib.util
+
+    for module, package in BENCH_PACKAGES.items():
+        try:
+            found = importlib.util.find_spec(module) is not None
+        except (ImportError, ValueError):
+            found = False
+        if not found:
+            raise ValueError(f"'sim system' needs the Python package {package}: pip install {package}")
+
+
+def run_mode(mode: str, work: Path, *, size, frames: int, sim: str) -> tuple[str, dict, Path]:
+    """The job (:func:`eyestereo.sim.job.run_jobs`) of one mode's run, in its own folder below ``work``."""
+    from eyestereo.sim.bench_stereo_frontend import PUBLIC
 
     w, h = size
-    sim = sim or fastest_simulator()
-    timing = dict(h_blank=64, v_sync=1, v_back=1, v_front=1)
-    tmp = Path(tempfile.mkdtemp(prefix=".system.", dir=Path(output).parent))
-    try:
-        def one(mode):
-            return run_bench("stereo_frontend", "tb_stereo_frontend",
-                             dict(mode=mode, frames=frames, images=f"files:{Path(left).resolve()},{Path(right).resolve()}",
-                                  timing=timing),
-                             name=f"cli_{mode}_{w}x{h}", params=dict(quantizers=f"rig:{w}x{h}", feature_words=512,
-                                                                     max_features=255),
-                             log_file=tmp / f"{mode}.log", sim=sim, public=PUBLIC if sim == "verilator" else None)
+    folder = work / mode
+    folder.mkdir()
+    return ("eyestereo.sim.runner:run_bench",
+            dict(block="stereo_frontend", bench="tb_stereo_frontend",
+                 config=dict(mode=mode, frames=frames, pair=[str(work / "left.npy"), str(work / "right.npy")],
+                             timing=TIMING),
+                 name=f"cli_{mode}_{w}x{h}", params=dict(quantizers=f"rig:{w}x{h}", feature_words=512, max_features=255),
+                 build_root=folder / "build", log_file=folder / f"{mode}.log", sim=sim,
+                 public=PUBLIC if sim == "verilator" else None),
+            folder)
 
-        # GHDL: both modes at once (2 cores); a Verilator build already uses both cores: one after the other
-        with ThreadPoolExecutor(1 if sim == "verilator" else 2) as ex:
-            reps = dict(zip(modes, ex.map(one, modes)))
-        ct = CameraTiming(width=w, height=h, **timing)
-        figs = {m: figures(r, ct) for m, r in reps.items()}
-        last = reps[modes[-1]]["last"]
-        _picture(np.array(last["rect"], np.int64), last["features"], tmp / "rectified.png")
-        matched = _matches_picture(np.array(last["rect"], np.int64), last["features"], tmp / "matches.png")
-        summary = dict(size=f"{w}x{h}", frames={m: len(r["frames"]) for m, r in reps.items()},
-                       fps={m: f["fps"] for m, f in figs.items()},
-                       sram_share={m: f["sram_share"] for m, f in figs.items()},
-                       sram_busy={m: f["sram_busy"] for m, f in figs.items()},
-                       features_last_frame=len(last["features"]), matches_last_frame=matched,
-                       bit_exact=all(r["bit_exact"] for r in reps.values()), simulator=sim_label(sim),
-                       clocks={"memory": 100.0, "harris": 50.0, "camera_l": 18.0, "camera_r": 17.9})
-        (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-        for m in modes:
-            (tmp / f"{m}.log").unlink(missing_ok=True)
-            (tmp / f"{m}.build.log").unlink(missing_ok=True)
-        if Path(output).exists():
-            shutil.rmtree(output)
-        tmp.rename(output)
-        tmp = None
-        return summary
-    finally:
-        if tmp is not None:
-            shutil.rmtree(tmp, ignore_errors=True)
+
+def simulate(left: np.ndarray, right: np.ndarray, folder: Path, work: Path, *, size=(48, 32), frames: int = 2,
+             modes=MODES, sim: str = "ghdl") -> dict:
+    """Run the system on an 8-bit grey pair (any size, resized to ``size``) in ``work`` (a run folder of
+    :func:`eyestereo.sim.job.run_folder`) and write the pictures and summary.json into ``folder``;
+    returns the summary. :class:`eyestereo.sim.job.JobFailed` when a simulation fails."""
+    import cv2
+
+    from eyestereo.sim.bench_stereo_frontend import figures
+    from eyestereo.sim.job import run_jobs
+    from eyestereo.sim.runner import describe
+    from eyestereo.tools.camera import CameraTiming
+    from eyestereo.tools.io import atomic_write_text
+
+    w, h = size
+    for name, img in (("left", left), ("right", right)):
+        np.save(work / f"{name}.npy", cv2.resize(img, (w, h), interpolation=cv2.INTER_AREA).astype(np.uint8))
+    jobs = [run_mode(m, work, size=size, frames=frames, sim=sim) for m in modes]
+    # GHDL: both modes at once (2 cores); a Verilator build already uses both cores: one after the other
+    reps = dict(zip(modes, run_jobs(jobs, at_once=1 if sim == "verilator" else 2, what=f"the simulation "
+                                    f"({describe(sim)})")))
+    ct = CameraTiming(width=w, height=h, **TIMING)
+    figs = {m: figures(r, ct) for m, r in reps.items()}
+    last = reps[modes[-1]]["last"]
+    _picture(np.array(last["rect"], np.int64), last["features"], folder / "rectified.png")
+    matched = _matches_picture(np.array(last["rect"], np.int64), last["features"], folder / "matches.png")
+    summary = dict(size=f"{w}x{h}", frames={m: len(r["frames"]) for m, r in reps.items()},
+                   fps={m: f["fps"] for m, f in figs.items()},
+                   sram_share={m: f["sram_share"] for m, f in figs.items()},
+                   sram_busy={m: f["sram_busy"] for m, f in figs.items()},
+                   features_last_frame=len(last["features"]), matches_last_frame=matched,
+                   bit_exact=all(r["bit_exact"] for r in reps.values()), simulator=describe(sim),
+                   clocks={"memory": 100.0, "harris": 50.0, "camera_l": 18.0, "camera_r": 17.9})
+    atomic_write_text(folder / "summary.json", json.dumps(summary, indent=2) + "\n")
+    return summary
+
+
+def main_system(left: Path, right: Path, output: Path, *, size=(48, 32), frames: int = 2, modes=MODES,
+                sim: str | None = None, json_file: Path | None = None, build_dir: Path | None = None) -> dict:
+    """The command's work for a library caller (``make demo``): check every input, run, write ``output``
+    (and ``json_file``) all or nothing; returns the summary. ValueError for bad input or a failed run."""
+    from eyestereo.sim.cli_rectify import read_pair
+    from eyestereo.sim.job import check_build_dir, run_folder
+    from eyestereo.sim.runner import check_simulator, fastest_simulator
+    from eyestereo.tools.io import Outputs
+
+    modes = list(modes)
+    if not modes or any(m not in MODES for m in modes):
+        raise ValueError(f"modes must be taken from {', '.join(MODES)}, got {modes}")
+    if not 1 <= int(frames) <= MAX_FRAMES:
+        raise ValueError(f"frames must be 1..{MAX_FRAMES}, got {frames}")
+    lg, rg = read_pair(left, right)
+    sim = check_simulator(sim or fastest_simulator())
+    check_bench_packages()
+    check_build_dir(build_dir)
+    with Outputs() as out:
+        folder = out.folder(output, OWNED, inputs=[left, right])
+        js = out.file(json_file) if json_file is not None else None
+        with run_folder("sim-system", build_dir) as work:
+            summary = simulate(lg, rg, folder, work, size=size, frames=int(frames), modes=modes, sim=sim)
+        if js is not None:
+            js.write_text(json.dumps(summary, indent=2) + "\n")
+    return summary
 
 
 def cmd_sim_system(args) -> int:
-    modes = [m.strip() for m in args.modes.split(",") if m.strip()]
-    bad = [m for m in modes if m not in MODES]
-    if bad or not modes:
-        print(f"error: --modes: choose from {list(MODES)}, got {args.modes!r}", file=sys.stderr)
-        return 1
-    for f in (args.left, args.right):
-        if not f.is_file():
-            print(f"error: {f}: no such image", file=sys.stderr)
-            return 1
-    if args.frames < 1:
-        print("error: --frames must be at least 1", file=sys.stderr)
-        return 1
-    if not args.output.parent.is_dir():
-        print(f"error: {args.output.parent}: no such folder", file=sys.stderr)
-        return 1
     w, h = args.size
-    try:
-        summary = main_system(args.left, args.right, args.output, size=args.size, frames=args.frames, modes=modes,
-                              sim=args.sim)
-    except (AssertionError, RuntimeError) as e:
-        print(f"error: the system simulation failed ({str(e).splitlines()[0][:200]})", file=sys.stderr)
-        return 1
-    if args.json:
-        args.json.write_text(json.dumps(summary, indent=2) + "\n")
+    summary = main_system(args.left, args.right, args.output, size=args.size, frames=args.frames, modes=args.modes,
+                          sim=args.sim, json_file=args.json, build_dir=args.build_dir)
     print(f"stereo front end, {w}x{h} cameras (18 / 17.9 MHz), memory 100 MHz, Harris 50 MHz "
           f"({summary['simulator']}, simulated time)")
-    for m in modes:
+    for m in args.modes:
         sh = summary["sram_share"][m]
         print(f"  {m:11s} frames {summary['frames'][m]}  fps {summary['fps'][m]:8.1f}  SRAM busy "
               f"{100 * summary['sram_busy'][m]:5.1f} %  " + " ".join(f"{x} {100 * sh[x]:.1f}%" for x in MASTERS))

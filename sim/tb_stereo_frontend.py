@@ -10,8 +10,19 @@ Every rectified pair and every feature list the host reads must equal, bit for b
 (:func:`eyestereo.tools.models.stereo_frontend.stereo_frontend`) of one stereo pair of the frames the
 cameras sent (which pair the system captured depends on the independent clocks: the bench finds it among
 the pairs of neighbouring frame indices, and requires the captured frames to move on), and so must the
-per-camera totals (FEATURES) and the per-block counts (FCOUNT) of that frame. At the end nothing is left
-over: no dropped frames, no overflows, the SRAM model saw no violation, the bus checker no fault.
+per-camera totals (FEATURES) and the per-block counts (FCOUNT) of that frame. The model runs with every
+parameter the top was built with that changes the result (:func:`model_params`: ``nms``, ``border``,
+``max_features``, ``frac`` from the config's ``params``, the block's own defaults for the absent ones), so a
+list cut at ``max_features`` (the trailer's overflow flag) is compared like any other. At the end nothing is
+left over: no dropped frames, no Harris-clock overflows, ``list_overflows`` (OVERFLOWS: the completed frames
+whose list was cut, see :func:`check_list_overflows`) equal to the model's count, the SRAM model saw no
+violation, the bus checker no fault. A frame without features is accepted (a flat scene has none); a
+configuration with ``require_features`` asks for features in every frame read (in one at least with
+``adaptive``: the closed loop may drive a frame to none on its way).
+
+The scene: ``images`` (:func:`stereo_frames`: ``random:S``, ``shift:S``, ``files:LEFT,RIGHT``) or ``pair``:
+``[left.npy, right.npy]``, each an (height, width) uint8 array at the camera size, the Y of every frame of
+that camera (:func:`pair_frames`).
 
 The report gives the frame clocks (FRAME_CLOCKS, the sequencer's measurement), the simulated time of
 each stage (capture, rectification, lists complete, host read-out) and the arbiter's per-master counters.
@@ -19,6 +30,8 @@ each stage (capture, rectification, lists complete, host read-out) and the arbit
 
 from __future__ import annotations
 
+import hashlib
+import inspect
 import time
 
 import cocotb
@@ -42,8 +55,9 @@ from eyestereo.tools.sram import SramPart
 
 
 def stereo_frames(spec: str, n: int, width: int, height: int) -> list[tuple[np.ndarray, np.ndarray]]:
-    """``n`` stereo pairs of camera words: ``random:S`` (independent random frames) or ``shift:S`` (one
-    random scene, the right camera's view shifted by a disparity, the scene moving a pixel per frame)."""
+    """``n`` stereo pairs of camera words: ``random:S`` (independent random frames), ``shift:S`` (one
+    random scene, the right camera's view shifted by a disparity, the scene moving a pixel per frame) or
+    ``files:LEFT,RIGHT`` (two image files, every frame: :func:`file_pair`)."""
     kind, _, arg = spec.partition(":")
     seed = int(arg or 1) if kind != "files" else 0
     out = []
@@ -55,30 +69,79 @@ def stereo_frames(spec: str, n: int, width: int, height: int) -> list[tuple[np.n
             big = camera_frame(f"random:{seed}", width + 2 * n + 8, height)
             out.append((big[:, i + 8:i + 8 + width].copy(), big[:, i + 4:i + 4 + width].copy()))
         elif kind == "files":  # a stereo pair of image files, resized to the camera size, every frame
-            import cv2
-
-            from eyestereo.tools.camera import yuv_frame
-
-            pair = []
-            for f in arg.split(","):
-                img = cv2.imread(f, cv2.IMREAD_GRAYSCALE)
-                if img is None:
-                    raise ValueError(f"cannot read image {f}")
-                pair.append(yuv_frame(cv2.resize(img, (width, height), interpolation=cv2.INTER_AREA)))
-            out.append(tuple(pair))
+            out.append(out[0] if out else file_pair(arg.split(","), width, height))
         else:
             raise ValueError(f"unknown stereo frame spec {spec!r}")
     return out
 
 
-def choose_thresholds(cal, frames, k, target: int, nms: int) -> int:
+def file_pair(files, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+    """The camera words of a stereo pair of image files: read by the library's one image-input rule
+    (:func:`eyestereo.tools.io.read_image` grey, :func:`~eyestereo.tools.io.to_grey8` on the pair: a
+    16-bit pair shares one shift), resized to the camera size (``cv2.INTER_AREA``)."""
+    import cv2
+
+    from eyestereo.tools.camera import yuv_frame
+    from eyestereo.tools.io import read_image, to_grey8
+
+    files = [str(f) for f in files]
+    if len(files) != 2:
+        raise ValueError(f"files: a stereo pair is two image files, got {len(files)}: {files}")
+    imgs = to_grey8([read_image(f, grey=True) for f in files], files)
+    return tuple(yuv_frame(cv2.resize(img, (width, height), interpolation=cv2.INTER_AREA)) for img in imgs)
+
+
+def pair_frames(pair, n: int, width: int, height: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """``n`` stereo frames of camera words from the config's ``pair``: [left.npy, right.npy], each an
+    (height, width) uint8 array at the camera size, the Y of every frame of that camera (U = V = 128)."""
+    from eyestereo.tools.camera import yuv_frame
+
+    if not isinstance(pair, (list, tuple)) or len(pair) != 2:
+        raise ValueError(f"pair: [left.npy, right.npy] expected, got {pair!r}")
+    words = []
+    for side, f in zip(("left", "right"), pair):
+        try:
+            a = np.load(f, allow_pickle=False)
+        except (OSError, ValueError) as e:
+            raise ValueError(f"pair: cannot read the {side} array {f}: {e}") from None
+        if a.dtype != np.uint8 or a.shape != (height, width):
+            raise ValueError(f"pair: the {side} array {f} is {a.dtype} {a.shape}; the cameras need uint8 "
+                             f"({height}, {width}) (height, width)")
+        words.append(yuv_frame(a))
+    return [tuple(words)] * n
+
+
+#: The top's parameters that change what the system computes, handed to the model by the bench
+#: (quantizers, the calibration, is handed as ``cal``). The others (share, feature_words, cam_depth, kind,
+#: read_latency, rect_depth) change timing or resources only; ``order`` is the cameras' byte order, which the
+#: camera models send in the default order (YUYV) only.
+MODEL_PARAMS = ("nms", "border", "max_features", "frac")
+
+
+def model_params(params: dict) -> dict:
+    """The keyword arguments of :func:`eyestereo.tools.models.stereo_frontend.stereo_frontend` for a top built
+    with ``params``: each of :data:`MODEL_PARAMS` from ``params``, else the block's own default (read from
+    :func:`eyestereo.hdl.stereo_frontend.stereo_frontend`'s signature, so the two cannot drift apart)."""
+    from eyestereo.hdl.stereo_frontend import stereo_frontend as top
+
+    sig = inspect.signature(top).parameters
+    return {name: params[name] if name in params else sig[name].default for name in MODEL_PARAMS}
+
+
+def frame_digest(words: np.ndarray) -> str:
+    """A frame's identity for the model cache (identical frames, e.g. a still pair, are modelled once)."""
+    a = np.ascontiguousarray(words, dtype=np.int64)
+    return hashlib.sha1(a.tobytes() + str(a.shape).encode()).hexdigest()
+
+
+def choose_thresholds(cal, frames, k, target: int, mp: dict) -> int:
     """The smallest power-of-two threshold code giving at most ``target`` features per camera on every
-    frame (computed with the model, before the simulation)."""
+    frame (computed with the model, before the simulation; ``mp``: :func:`model_params`)."""
     for e in range(0, 20):
         code = 1 << e
         ok = True
         for left, right in frames[:2]:
-            tot = model.stereo_frontend(cal, left, right, k, [code] * 16, nms=nms)["list"]["totals"]
+            tot = model.stereo_frontend(cal, left, right, k, [code] * 16, **mp)["list"]["totals"]
             ok &= int(max(tot)) <= target
         if ok:
             return code
@@ -92,15 +155,22 @@ async def frames_bit_exact(dut):
 
     cal = calibration_param(cfg["params"]["quantizers"], None, None)
     w, h = cal.width, cal.height
-    nms = cfg["params"].get("nms", 3)
+    mp = model_params(cfg["params"])  # what the top was built with, for the model
     mode = cfg.get("mode", "sequential")
     n_host = cfg.get("frames", 3)
     # sequential: each frame lets a few camera frames pass (arming, read-out): enough for every one
     n_cam = cfg.get("camera_frames", 5 * n_host + 4)
     amap = AddressMap(w, h, cfg["params"].get("feature_words", 2048))
-    frames = stereo_frames(cfg.get("images", "random:1"), n_cam, w, h)
+    if cfg.get("pair") is not None:
+        if cfg.get("images") is not None:
+            raise ValueError("give the scene as images or as pair, not both")
+        frames = pair_frames(cfg["pair"], n_cam, w, h)
+    else:
+        frames = stereo_frames(cfg.get("images") or "random:1", n_cam, w, h)
+    digests = [(frame_digest(a), frame_digest(b)) for a, b in frames]
     k = k_code(0.04)
-    thr = cfg.get("threshold") or choose_thresholds(cal, frames, k, cfg.get("target", 40), nms)
+    thr = cfg["threshold"] if cfg.get("threshold") is not None else \
+        choose_thresholds(cal, frames, k, cfg.get("target", 40), mp)
 
     # clocks: memory 100 MHz, Harris 50 MHz (or as configured), cameras on their own
     Clock(dut.clk, 10, unit="ns").start()
@@ -171,10 +241,10 @@ async def frames_bit_exact(dut):
         ctrls = [SecantController(adaptive, init=thr) for _ in range(2)]
 
     def model_of(i, j):
-        key = (i, j, tuple(cur[0]), tuple(cur[1]))
+        key = (digests[i][0], digests[j][1], tuple(cur[0]), tuple(cur[1]))
         if key not in expected:
             expected[key] = model.stereo_frontend(cal, frames[i][0], frames[j][1], k, (list(cur[0]), list(cur[1])),
-                                                  nms=nms)
+                                                  **mp)
         return expected[key]
 
     def find(pred, last, diff=None):
@@ -240,8 +310,10 @@ async def frames_bit_exact(dut):
         pl = find(lambda m: m["list_words"] == lw, last_list)
         lst = parse_words([(d, False, False) for d in lw[:-1]] + [(lw[-1], True, True)])[0]
         last = dict(rect=rect.tolist(), features=[list(f) for f in lst["features"]])
+        ml = model_of(*pl)["list"]  # the model's list of that pair: equal to what the host read
         results.append(dict(frame=n, rect_pair=pr, list_pair=pl, features=len(lst["features"]),
-                            start_ns=t0, frame_ns=t_frame, read_ns=t_read))
+                            overflow=bool(lst["overflow"]), model_totals=[int(v) for v in ml["totals"]],
+                            model_overflow=bool(ml["overflow"]), start_ns=t0, frame_ns=t_frame, read_ns=t_read))
         last_rect, last_list = pr, pl
         # the totals and per-block counts belong to the last complete frame: the list's pair, or a later
         # one in the overlapped mode (the system goes on meanwhile): it must be one of the frames sent
@@ -266,16 +338,50 @@ async def frames_bit_exact(dut):
     st = await drv.status()
     arb = await drv.arbiter()
     assert st["dropped_left"] == st["dropped_right"] == 0, st
-    assert st["harris_overflows"] == 0 and st["list_overflows"] == 0, st
+    assert st["harris_overflows"] == 0, st
+    ovf = check_list_overflows(st, results, [model_of(i, j)["list"]["overflow"] for i in range(n_cam)
+                                             for j in range(max(0, i - 1), min(n_cam, i + 2))]
+                               if st["frames"] > len(results) and adaptive is None else None)
     assert sram.error is None, sram.error
     bus.checker.check()
-    # a frame without features tests little (the closed loop may drive one frame to none on its way)
-    assert all(r["features"] > 0 for r in results) if adaptive is None else any(r["features"] for r in results)
+    if cfg.get("require_features"):
+        # the configuration asks for features (a frame without any tests little); the closed loop may drive
+        # one frame to none on its way
+        assert all(r["features"] > 0 for r in results) if adaptive is None else \
+            any(r["features"] for r in results), [r["features"] for r in results]
     write_report(cfg, dict(mode=mode, width=w, height=h, threshold=thr, frames=results, bit_exact=True,
+                           model_params=mp, list_overflows=ovf,
                            frame_clocks=st["frame_clocks"], frames_done=st["frames"], arb=arb,
                            arb_words=list(ARB_WORDS), total_ns=get_sim_time(unit="ns") - t_start,
                            camera_frame_pclk=timing.frame_pclk, axi=bus.checker.counts, last=last,
                            stages=stage_times(events, [r["start_ns"] for r in results])))
+
+
+def check_list_overflows(st: dict, results: list[dict], candidates: list[bool] | None) -> dict:
+    """Check OVERFLOWS.list_overflows against the model; returns what was checked (for the report).
+
+    What the counter counts (hdl/frontend_sequencer.py, register map OVERFLOWS): the frames the system
+    *completed* since reset (feature_list's ``frame_done``, the FRAMES register) whose list was cut
+    (feature_list's ``overflow``: more than ``max_features`` features, or one finding the list FIFO full,
+    which the model never does). The frames the host read are known: their lists were compared with the
+    model's, trailer and overflow flag included. When the system completed more (overlapped, continuous:
+    it goes on while the host reads), the others' pairs are not known: ``candidates``, the model's flag of
+    every stereo pair the bench considers, gives their count when all agree (a still scene), else the
+    counter is only bounded by the read frames' count and that plus the unread frames."""
+    done, got = int(st["frames"]), int(st["list_overflows"])
+    read = sum(1 for r in results if r["overflow"])
+    unread = done - len(results)
+    assert unread >= 0, f"the host read {len(results)} frames, the system completed {done}"
+    if unread == 0:
+        rule, lo, hi = "the frames read", read, read
+    elif candidates and len(set(map(bool, candidates))) == 1:
+        n = read + unread * bool(candidates[0])
+        rule, lo, hi = "the frames read and every candidate pair alike", n, n
+    else:
+        rule, lo, hi = "bounded: the unread frames' pairs are not known", read, read + unread
+    assert lo <= got <= hi, (f"list_overflows {got}: the model's lists of the {done} completed frames give "
+                             f"{lo if lo == hi else f'{lo}..{hi}'} ({rule}; {read} of the {len(results)} read)", st)
+    return dict(counted=got, expected=[lo, hi], rule=rule, frames_done=done, frames_read=len(results))
 
 
 def stage_times(events, starts) -> dict:

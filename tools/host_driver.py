@@ -13,12 +13,18 @@ and windows take an index), every field is reachable by name through :meth:`Host
 with the bus checker); :class:`ModelBus` runs the driver on the bank's model; a real host wraps its
 memory-mapped window the same way. A response other than OKAY raises :class:`BusError`.
 
+Every value given to the driver (a word, a field, a threshold, an SRAM word, an index or an SRAM range)
+is checked against the table before anything moves on the bus (:meth:`eyestereo.tools.regmap.Field.check`,
+:meth:`~eyestereo.tools.regmap.Register.check_value`): a value that does not fit raises one-line
+ValueError naming the register, the value and the range, instead of being masked into another value
+(a threshold of 2**20 into 0, -1 into 0xFFFFF, 1.9 into 1). Words read back are masked to their fields.
+
 Plain Python (no MyHDL, no cocotb).
 """
 
 from __future__ import annotations
 
-from eyestereo.tools.regmap import ARB_WORDS, OKAY, REGMAP, RegisterMap
+from eyestereo.tools.regmap import ARB_WORDS, OKAY, REGMAP, RegisterMap, check_bits
 
 __all__ = ["HostDriver", "BusError", "ModelBus"]
 
@@ -54,16 +60,26 @@ class HostDriver:
 
     # ---- words ---------------------------------------------------------------------------------------
     async def read(self, name: str, index: int = 0) -> int:
-        """The word of register ``name`` (word ``index`` of an array, window or memory)."""
+        """The word of register ``name`` (word ``index`` of an array, window or memory; an index outside
+        0..count-1 is refused: :meth:`~eyestereo.tools.regmap.Register.check_index`)."""
         r = self.regmap[name]
+        index = r.check_index(index)
         data, resp = await self.bus.read(r.address(index))
         if resp != OKAY:
             raise BusError(f"read of {name}[{index}] at {r.address(index):#x}: response {resp}")
         return int(data)
 
     async def write(self, name: str, value: int, index: int = 0, strb: int = 0xF) -> None:
+        """Write the word ``value`` to register ``name`` (word ``index``; byte strobes ``strb``).
+
+        Refused (ValueError, nothing written): an index outside the register's words, a value that is not
+        an integer or sets bits outside the register's fields (THR_LEFT: 0..2**20-1, SRAM: 0..65535;
+        :meth:`~eyestereo.tools.regmap.Register.check_value`), a ``strb`` outside 0..15.
+        """
         r = self.regmap[name]
-        resp = await self.bus.write(r.address(index), int(value) & 0xFFFFFFFF, strb)
+        word = r.check_value(value, index)
+        strb = check_bits(strb, 0xF, f"{r.label(int(index))} wstrb")
+        resp = await self.bus.write(r.address(index), word, strb)
         if resp != OKAY:
             raise BusError(f"write of {name}[{index}] at {r.address(index):#x}: response {resp}")
 
@@ -75,15 +91,18 @@ class HostDriver:
 
     async def set(self, **fields: int) -> None:
         """Set fields; fields of one ``rw`` register are written together (read-modify-write), a ``pulse``
-        register's given fields are written as ones (zeros do nothing)."""
+        register's given fields are written as ones (zeros do nothing).
+
+        Every value is checked before anything is written (:meth:`~eyestereo.tools.regmap.Field.check`):
+        an integer 0..2**width-1, a bool only for a 1-bit field; otherwise ValueError, e.g.
+        ``K_LEFT.k_left: 256 does not fit (0..255, 8 bits)``.
+        """
         by_reg: dict[str, list] = {}
         for name, value in fields.items():
             r, f = self.regmap.field(name)
             if r.kind not in ("rw", "pulse"):
                 raise KeyError(f"field {name} is in {r.kind} register {r.name}: set() takes rw and pulse fields")
-            if not 0 <= int(value) < (1 << f.width):
-                raise ValueError(f"field {name} is {f.width} bits wide, {value!r} does not fit")
-            by_reg.setdefault(r.name, []).append((f, int(value)))
+            by_reg.setdefault(r.name, []).append((f, f.check(value, f"{r.name}.{f.name}")))
         for reg, items in by_reg.items():
             r = self.regmap[reg]
             word = await self.read(reg) if r.kind == "rw" else 0
@@ -108,26 +127,51 @@ class HostDriver:
 
     async def configure(self, *, mode: str = "sequential", continuous: bool = False, k_left: int | None = None,
                         k_right: int | None = None, thresholds_left=None, thresholds_right=None) -> None:
-        """Mode, k codes and block thresholds (codes; ``None`` leaves a value as it is)."""
+        """Mode, k codes and block thresholds (codes; ``None`` leaves a value as it is).
+
+        Every value is checked before anything is written: ``mode`` one of the field's names,
+        ``continuous`` a bool (or 0/1), the k codes 0..255, the thresholds as :meth:`write_thresholds`
+        takes them; a value that does not fit raises ValueError (never masked or truncated: k 1.9 is refused,
+        not written as 1).
+        """
         modes = dict(self.regmap.field("mode")[1].values)
         code = {v: k for k, v in modes.items()}.get(mode)
         if code is None:
             raise ValueError(f"mode must be one of {sorted(modes.values())}, got {mode!r}")
-        await self.set(mode=code, continuous=int(bool(continuous)))
-        for name, k in (("k_left", k_left), ("k_right", k_right)):
-            if k is not None:
-                await self.set(**{name: int(k)})
-        for reg, thr in (("THR_LEFT", thresholds_left), ("THR_RIGHT", thresholds_right)):
-            if thr is not None:
-                await self.write_thresholds(reg, thr)
+        ctrl = dict(mode=code, continuous=continuous)
+        ks = {name: k for name, k in (("k_left", k_left), ("k_right", k_right)) if k is not None}
+        thrs = [(reg, self._threshold_codes(reg, thr)) for reg, thr in
+                (("THR_LEFT", thresholds_left), ("THR_RIGHT", thresholds_right)) if thr is not None]
+        for name, value in {**ctrl, **ks}.items():
+            r, f = self.regmap.field(name)
+            f.check(value, f"{r.name}.{f.name}")
+        await self.set(**ctrl)
+        for name, k in ks.items():
+            await self.set(**{name: k})
+        for reg, codes in thrs:
+            for i, c in enumerate(codes):
+                await self.write(reg, c, i)
 
-    async def write_thresholds(self, reg: str, codes) -> None:
+    def _threshold_codes(self, reg: str, codes) -> list[int]:
+        """The threshold codes as Python ints, every one checked (:meth:`write_thresholds`)."""
         r = self.regmap[reg]
-        codes = [int(c) for c in codes]
+        if r.kind != "array":
+            raise ValueError(f"{reg} is a {r.kind} register, thresholds go to an array (THR_LEFT, THR_RIGHT)")
+        codes = list(codes)
         if len(codes) > r.count:
             raise ValueError(f"{reg} has {r.count} blocks, got {len(codes)} thresholds")
-        for i, c in enumerate(codes):
-            await self.write(reg, c & r.mask, i)
+        return [r.check_value(c, i) for i, c in enumerate(codes)]
+
+    async def write_thresholds(self, reg: str, codes) -> None:
+        """Block thresholds (codes, block 0 first) into the array ``reg`` (THR_LEFT or THR_RIGHT).
+
+        All codes are checked before the first is written: at most ``count`` of them, each an integer
+        0..2**20-1 (numpy integers too); a code that does not fit (2**20, -1, 1.9, 2.0, True) raises
+        ValueError, e.g. ``THR_LEFT[3]: 1048576 does not fit (0..1048575, 20 bits)``, instead of being
+        masked into another threshold (2**20 would become 0: every pixel passes).
+        """
+        for i, c in enumerate(self._threshold_codes(reg, codes)):
+            await self.write(reg, c, i)
 
     async def read_thresholds(self, reg: str) -> list[int]:
         return [await self.read(reg, i) for i in range(self.regmap[reg].count)]
@@ -176,12 +220,21 @@ class HostDriver:
         return {**await self.status(), **{f"arb_{k}": v for k, v in (await self.arbiter()).items()}}
 
     async def read_sram_words(self, word: int, count: int) -> list[int]:
-        """``count`` SRAM words from word address ``word`` (through the host port)."""
-        return [await self.read("SRAM", word + i) for i in range(count)]
+        """``count`` SRAM words from word address ``word`` (through the host port); a range that leaves
+        the SRAM window is refused before the first read
+        (:meth:`~eyestereo.tools.regmap.Register.check_words`)."""
+        return [await self.read("SRAM", i) for i in self.regmap["SRAM"].check_words(word, count)]
 
     async def write_sram_words(self, word: int, values) -> None:
-        for i, v in enumerate(values):
-            await self.write("SRAM", int(v) & 0xFFFF, word + i)
+        """SRAM words ``values`` from word address ``word`` on. The range must lie in the SRAM window and
+        every value be an integer 0..65535 (16-bit words); both are checked before the first write, a
+        value that does not fit raises ValueError (``SRAM word 0x5: 65536 does not fit (0..65535, 16 bits)``)
+        instead of being masked into another word."""
+        r = self.regmap["SRAM"]
+        values = list(values)
+        words = [(i, r.check_value(v, i)) for i, v in zip(r.check_words(word, len(values)), values)]
+        for i, v in words:
+            await self.write("SRAM", v, i)
 
 
 def _accessors(regmap: RegisterMap) -> None:

@@ -48,6 +48,7 @@ __all__ = [
     "atomic_write_bytes",
     "atomic_write_text",
     "check_image_bytes",
+    "check_not_inputs",
     "dir_mode",
     "file_mode",
     "read_image",
@@ -277,16 +278,19 @@ back as it was. An exception in the block discards every temporary.
         self._items.append((t, tmp, "file", None))
         return tmp
 
-    def folder(self, target: str | os.PathLike[str], owned: Callable[[str], bool] | Any = None) -> Path:
+    def folder(self, target: str | os.PathLike[str], owned: Callable[[str], bool] | Any = None, *,
+               inputs: Any = ()) -> Path:
         """Register output folder ``target`` (created, or replaced as a whole); returns the empty
         temporary folder to fill. ``owned``: the names (a collection, a regular expression string or a
         predicate on a name) this command writes into it; an existing ``target`` holding anything
-        else is refused."""
+        else is refused. ``inputs``: the files (and folders) the command reads; a target that holds
+        one of them is refused, even when its name is one the command writes (``sim harris`` reading
+        ``out/left.png`` and writing ``out/``'s ``left.png``)."""
         self._check_open()
         t = Path(target)
         self._check_unique(t)
         pred = _owned_predicate(owned)
-        check_output_folder(t, pred)
+        check_output_folder(t, pred, inputs=inputs)
         try:
             tmp = Path(tempfile.mkdtemp(prefix=f".{t.name}{TMP_MARK}", dir=_folder_of(t)))
         except OSError as e:
@@ -374,8 +378,13 @@ back as it was. An exception in the block discards every temporary.
 
     def _check_unique(self, t: Path) -> None:
         for other in self.targets:
-            if os.path.abspath(other) == os.path.abspath(t):
+            a, b = Path(os.path.realpath(other)), Path(os.path.realpath(t))
+            if a == b:
                 raise ValueError(f"{t} is given as two different outputs")
+            if a in b.parents or b in a.parents:
+                inner, outer = (t, other) if a in b.parents else (other, t)
+                raise ValueError(f"{inner} lies inside {outer}, another output of this command; give it "
+                                 "another place")
 
 
 def _owned_predicate(owned: Any) -> Callable[[str], bool]:
@@ -390,9 +399,11 @@ def _owned_predicate(owned: Any) -> Callable[[str], bool]:
     return lambda name: name in names
 
 
-def check_output_folder(folder: str | os.PathLike[str], owned: Callable[[str], bool] | Any = None) -> None:
-    """ValueError unless ``folder`` may be (re)placed: it is named, its parent exists, and it is
-    missing, empty, or holds only files (and folders of files) whose names ``owned`` accepts."""
+def check_output_folder(folder: str | os.PathLike[str], owned: Callable[[str], bool] | Any = None, *,
+                        inputs: Any = ()) -> None:
+    """ValueError unless ``folder`` may be (re)placed: it is named, its parent exists, it holds none of
+    the command's ``inputs``, and it is missing, empty, or holds only files (and folders of files) whose
+    names ``owned`` accepts."""
     t = Path(folder)
     pred = _owned_predicate(owned)
     if t.name in ("", ".", "..") or str(t) in (os.sep, "."):
@@ -402,6 +413,7 @@ def check_output_folder(folder: str | os.PathLike[str], owned: Callable[[str], b
         raise ValueError(f"cannot create {t}: folder {parent} does not exist")
     if t.is_symlink() or (t.exists() and not t.is_dir()):
         raise ValueError(f"{t} exists and is not a folder")
+    check_not_inputs(t, inputs)
     if not t.exists():
         return
     for p in sorted(t.iterdir()):
@@ -411,6 +423,19 @@ def check_output_folder(folder: str | os.PathLike[str], owned: Callable[[str], b
         if not ok:
             raise ValueError(f"{t} holds {p.name}, which this command does not write; give a new or empty "
                              f"folder (an existing one is replaced as a whole)")
+
+
+def check_not_inputs(folder: str | os.PathLike[str], inputs: Any) -> None:
+    """ValueError when output ``folder`` is, or holds, one of the ``inputs`` (files or folders a command
+    reads): replacing the folder would delete them. Paths are compared after resolving links."""
+    t = Path(os.path.realpath(folder))
+    for item in inputs or ():
+        if item is None:
+            continue
+        p = Path(os.path.realpath(item))
+        if p == t or t in p.parents:
+            raise ValueError(f"{folder} holds {item}, an input of this command; give another output folder "
+                             "(it would be replaced)")
 
 
 def _aside(t: Path) -> Path:

@@ -19,18 +19,25 @@ Register kinds (:data:`KINDS`): every register is one 32-bit word (``const``, ``
 ``status``) or an aligned group of ``count`` words (``array``, ``window``, ``memory``); byte addresses,
 word aligned (the low two address bits are ignored).
 
+Values are checked here, once, for every user of the table: :meth:`Field.check` (a field's value),
+:meth:`Register.check_value` (a word and its index), :meth:`Register.check_words` (a run of words) and
+:func:`check_frame_size` (the bank's ``width``/``height``). A value that does not fit is refused with one
+line naming the register, the value and the range, never masked into another value.
+
 This module is plain Python (no MyHDL, no cocotb), so a host program can use it.
 """
 
 from __future__ import annotations
 
 import argparse
+import numbers
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
 __all__ = ["Field", "Register", "RegisterMap", "REGISTERS", "REGMAP", "KINDS", "OKAY", "SLVERR", "K_BITS",
-           "THRESHOLD_BITS", "ARB_WORDS", "RegisterMapError"]
+           "THRESHOLD_BITS", "ARB_WORDS", "RegisterMapError", "RegisterIndexError", "FRAME_MIN", "FRAME_MAX",
+           "check_frame_size", "check_bits"]
 
 #: AXI response codes the bank gives (AXI4-Lite has no EXOKAY; DECERR is not used).
 OKAY, SLVERR = 0, 2
@@ -41,6 +48,11 @@ K_BITS = 8
 THRESHOLD_BITS = 20
 #: k = 0.04 as the k port's code (round(0.04 * 256), ``tools.models.harris_mono.k_code(0.04)``).
 K_RESET = 10
+
+#: The frame sizes the register bank is built for (its ``width``/``height`` parameters, which GEOMETRY
+#: reports): the rule of :func:`eyestereo.hdl.register_bank.register_bank` and of its model, kept here
+#: because tools/ never imports hdl/ (4096 is also ``eyestereo.hdl.common.checks.MAX_SIZE``).
+FRAME_MIN, FRAME_MAX = 2, 4096
 
 #: The SRAM arbiter's status words in its status port's order (names for the host driver; their meaning
 #: is ``STAT`` in eyestereo.tools.models.sram_arbiter, which the test checks this against).
@@ -68,6 +80,74 @@ class RegisterMapError(ValueError):
     """The table is inconsistent (overlaps, fields outside the word, duplicate names, ...)."""
 
 
+class RegisterIndexError(IndexError, ValueError):
+    """A word index outside a register's words (a ValueError like every refused value; an IndexError as
+    :meth:`Register.address` raised before)."""
+
+
+def _is_bool(value) -> bool:
+    """True for Python and numpy bools."""
+    return isinstance(value, bool) or getattr(getattr(value, "dtype", None), "kind", None) == "b"
+
+
+def _shown(value) -> str:
+    """A refused value as a message shows it (integers in decimal, anything else by repr, kept short)."""
+    if isinstance(value, numbers.Integral) and not _is_bool(value):
+        return str(int(value))
+    text = str(value) if isinstance(value, numbers.Number) or _is_bool(value) else repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _range(mask: int) -> str:
+    """The values a mask allows, for a message: ``0..1048575, 20 bits`` or ``the fields' bits 0x303 only``."""
+    if mask & (mask + 1) == 0:
+        n = mask.bit_length()
+        return f"0..{mask}, {n} bit{'s' if n != 1 else ''}"
+    return f"the fields' bits {mask:#x} only"
+
+
+def check_bits(value, mask: int, where: str) -> int:
+    """``value`` as a Python int; ValueError unless it is an integer (Python or numpy; a bool only where
+    ``mask`` is one bit; a float, even 2.0, is refused) that sets no bit outside ``mask``. The one-line
+    message starts with ``where`` and gives the value and the range: ``THR_LEFT[3]: 1048576 does not fit
+    (0..1048575, 20 bits)``. The check behind :meth:`Field.check` and :meth:`Register.check_value`."""
+    if _is_bool(value) and mask != 1:
+        raise ValueError(f"{where}: {_shown(value)} is a bool, not an integer ({_range(mask)})")
+    if not (_is_bool(value) or isinstance(value, numbers.Integral)):
+        raise ValueError(f"{where}: {_shown(value)} is not an integer ({_range(mask)})")
+    v = int(value)
+    if v < 0 or v & ~mask:
+        raise ValueError(f"{where}: {v} does not fit ({_range(mask)})")
+    return v
+
+
+def _is_int(value) -> bool:
+    return isinstance(value, numbers.Integral) and not _is_bool(value)
+
+
+def check_frame_size(width, height) -> tuple[int, int]:
+    """The register bank's ``width``/``height`` parameters as Python ints; ValueError unless each is an
+    integer (numpy integers too; not a bool or a float) in :data:`FRAME_MIN`..:data:`FRAME_MAX`.
+
+    The rule of :func:`eyestereo.hdl.register_bank.register_bank` (which calls this, its message then
+    starting with ``register_bank: ``) and of its model, so that the model refuses exactly the banks that
+    cannot be built; the range is the SRAM arbiter's (``hdl/sram_arbiter.py``), whose frame the GEOMETRY
+    register reports.
+    """
+    out = []
+    for name, v in (("width", width), ("height", height)):
+        allowed = f"the bank takes {FRAME_MIN}..{FRAME_MAX}"
+        if not _is_int(v):
+            raise ValueError(f"parameter {name} must be an integer, got {type(v).__name__} {_shown(v)} ({allowed})")
+        v = int(v)
+        if v < FRAME_MIN:
+            raise ValueError(f"parameter {name}={v} is too small: {allowed}")
+        if v > FRAME_MAX:
+            raise ValueError(f"parameter {name}={v} is too large: {allowed}")
+        out.append(v)
+    return out[0], out[1]
+
+
 @dataclass(frozen=True)
 class Field:
     """A field of a register: bits ``lsb + width - 1 .. lsb``.
@@ -93,6 +173,14 @@ class Field:
     @property
     def bits(self) -> str:
         return f"{self.lsb}" if self.width == 1 else f"{self.lsb + self.width - 1}:{self.lsb}"
+
+    def check(self, value, where: str | None = None) -> int:
+        """``value`` as a Python int; ValueError unless it fits the field: an integer (Python or numpy; a
+        bool only in a 1-bit field; a float, even 2.0, is refused) in 0..2**width-1. Nothing is masked:
+        a code that does not fit would otherwise reach the hardware as another code (2**20 as threshold
+        0). ``where`` names the field in the message (default: its name), e.g.
+        ``K_LEFT.k_left: 256 does not fit (0..255, 8 bits)``."""
+        return check_bits(value, (1 << self.width) - 1, where or self.name)
 
 
 @dataclass(frozen=True)
@@ -135,9 +223,56 @@ class Register:
         return v
 
     def address(self, index: int = 0) -> int:
-        if not 0 <= index < self.count:
-            raise IndexError(f"register {self.name} has {self.count} word(s), index {index} is outside")
-        return self.offset + 4 * index
+        """Byte address of word ``index`` (:meth:`check_index` first)."""
+        return self.offset + 4 * self.check_index(index)
+
+    def label(self, index: int = 0) -> str:
+        """How messages name word ``index``: ``CTRL``, ``THR_LEFT[3]``, ``SRAM word 0x12345``."""
+        if self.kind == "memory":
+            return f"{self.name} word {index:#x}"
+        return self.name if self.count == 1 else f"{self.name}[{index}]"
+
+    def check_index(self, index) -> int:
+        """``index`` as a Python int; :class:`RegisterIndexError` (a ValueError and an IndexError) unless
+        it is an integer in 0..count-1: ``THR_LEFT: index 16 is outside 0..15`` or, for the memory,
+        ``SRAM word 0x100000 is outside the window (0..0xfffff)``."""
+        if self.kind == "memory":
+            what = f"{self.name} word {index:#x}" if _is_int(index) else f"{self.name} word {_shown(index)}"
+            within, outside = f"the window is 0..{self.count - 1:#x}", f"the window (0..{self.count - 1:#x})"
+        else:
+            what = f"{self.name}: index {_shown(index)}"
+            within = outside = f"0..{self.count - 1}"
+        if not _is_int(index):
+            raise RegisterIndexError(f"{what} is not an integer ({within})")
+        if not 0 <= int(index) < self.count:
+            raise RegisterIndexError(f"{what} is outside {outside}")
+        return int(index)
+
+    def check_words(self, first, count) -> range:
+        """Word indices ``first`` .. ``first + count - 1`` (a run of memory or array words) as a range;
+        :class:`RegisterIndexError` unless both are integers, ``count`` >= 0 and every word lies in
+        0..count-1 (the message names the first word outside), checked before any word moves."""
+        if not _is_int(count) or count < 0:
+            raise RegisterIndexError(f"{self.name}: word count {_shown(count)} is not an integer >= 0")
+        self.check_index(first)
+        first, count = int(first), int(count)
+        if first + count > self.count:
+            try:
+                self.check_index(self.count)
+            except RegisterIndexError as e:
+                start = f"{first:#x}" if self.kind == "memory" else str(first)
+                raise RegisterIndexError(f"{e}; asked for {count} words from {start}") from None
+        return range(first, first + count)
+
+    def check_value(self, value, index=0) -> int:
+        """The word ``value`` for word ``index`` as a Python int; ValueError unless the index is in
+        0..count-1 and the value an integer that sets only the bits of the register's fields: 0..2**20-1
+        for THR_LEFT, 0..255 for K_LEFT, 0..65535 for an SRAM word, CTRL's bits 0x303 (a read-only register
+        takes any 32-bit word: the bank answers SLVERR). Floats (even 2.0) are refused, a bool only where
+        the word is one bit; nothing is masked. E.g. ``THR_LEFT[3]: 1048576 does not fit (0..1048575, 20 bits)``."""
+        index = self.check_index(index)
+        mask = self.mask if self.kind in WRITABLE else 0xFFFFFFFF
+        return check_bits(value, mask, self.label(index))
 
 
 _SEQ = "the system's sequencer (issue 15 item 2)"
@@ -208,7 +343,7 @@ REGISTERS: tuple[Register, ...] = (
              (_f("harris_overflows", 0, 16, "stereo frames cut crossing into the Harris clock",
                  connect="stream_cdc dropped: the crossing into the Harris clock (back through a word_cdc) plus the "
                          "flags' crossing back"),
-              _f("list_overflows", 16, 16, "feature lists that did not fit their SRAM buffer",
+              _f("list_overflows", 16, 16, "completed frames whose feature list was cut at max_features (its trailer's overflow flag)",
                  connect=_SEQ + " (counts the lists flagged overflowed in ARB words 20, 21)"))),
     Register("FRAME_CLOCKS", 0x030, "status", "memory clocks the last completed frame took from its start "
              "(frames/s = 100e6 / value)", (_f("frame_clocks", 0, 32, "clocks", connect=_SEQ),)),

@@ -165,7 +165,7 @@ BAD = {
     "plots parent missing": (["fit", "{d}/maps.npz", "--plots", "{d}/noplots/sub", "-o", "{d}/out.json"], 1,
                              "does not exist"),
     "plots into a used folder": (["fit", "{d}/maps.npz", "--plots", "{d}", "-o", "{d}/out.json"], 1,
-                                 "which this command does not write"),
+                                 "out.json lies inside"),
     "wrong image size": (["warp", "{d}/small.png", "{d}/maps.npz", "--side", "left", "-o", "{d}/out.png"], 1,
                          "image is 40x30 but the maps were made for 352x288"),
     "missing image": (["warp", "{d}/none.png", "{d}/maps.npz", "--side", "left", "-o", "{d}/out.png"], 1,

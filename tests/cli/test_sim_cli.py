@@ -80,7 +80,8 @@ def test_sim_rectify_bad_input(made, capfd):
         ((made / "nope", left, right), "no such folder"),
         ((plain, left, right), "has no vhdl/rectifier.json"),
         ((made / "rig", left, right), "holds no quantizers.json"),
-        ((made / "rect", small, right), "is 30x20; the rectifier was made for 352x288"),
+        ((made / "rect", small, small), "the images are 30x20; the rectifier in"),
+        ((made / "rect", small, right), "the images differ in size: left"),
         ((made / "rect", left, made / "broken.png"), "broken.png"),
         ((made / "rect", left, made / "missing.png"), "missing.png"),
     ]

@@ -128,7 +128,9 @@ def test_model_pulses_arrays_windows_memory_and_errors():
     for ro in (0x000, 0x010, 0x020, 0x200):
         assert b.write(ro, 1) == SLVERR
     b.set_input("frames", 7)
-    b.set_input("features_right", 0x1FFFF)  # 16 bits
+    with pytest.raises(ValueError, match=r"^FEATURES\.features_right: 131071 does not fit \(0\.\.65535, 16 bits\)$"):
+        b.set_input("features_right", 0x1FFFF)  # 16 bits: refused, not masked
+    b.set_input("features_right", 0xFFFF)
     assert b.read(0x020) == (7, OKAY) and b.read(0x024) == (0xFFFF << 16, OKAY)
     b.reset()
     assert b.read(0x104) == (0, OKAY) and b.read(0x014) == (10, OKAY) and b.events == []
@@ -163,7 +165,9 @@ def test_driver_by_name_on_the_model():
         assert (await drv.counters())["arb_moved_host"] == 15
         with pytest.raises(TimeoutError):
             await drv.wait_frame(timeout_clocks=3000, poll_clocks=1000)
-        await drv.write_sram_words(10, [1, 2, 0x1FFFF])
+        with pytest.raises(ValueError, match=r"^SRAM word 0xc: 131071 does not fit \(0\.\.65535, 16 bits\)$"):
+            await drv.write_sram_words(10, [1, 2, 0x1FFFF])  # refused before anything moves on the bus
+        await drv.write_sram_words(10, [1, 2, 0xFFFF])
         assert await drv.read_sram_words(10, 3) == [1, 2, 0xFFFF]
 
     run(body())

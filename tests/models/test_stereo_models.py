@@ -59,3 +59,18 @@ def test_empty_frame_gives_a_trailer_alone():
     z = np.zeros((9, 9), int)
     res = fl.feature_list(z, z, blocks=(1, 1), border=3)
     assert res["words"] == [(0xFFFF, False, False), (0, True, True)]
+
+
+def test_system_model_defaults_are_the_tops():
+    """The system model's defaults (max_features above all: the list's cut) are the top's, read from its
+    signature: a bench or a caller leaving one out gets what the hardware builds by default."""
+    import inspect
+
+    from eyestereo.hdl.stereo_frontend import stereo_frontend as top
+    from eyestereo.tools.models import stereo_frontend as sf
+
+    hw = inspect.signature(top).parameters
+    sw = inspect.signature(sf.stereo_frontend).parameters
+    assert sw["max_features"].default == hw["max_features"].default
+    for name in ("nms", "border", "frac"):
+        assert sw[name].default == hw[name].default, name

@@ -283,6 +283,7 @@ def run_command(parser: argparse.ArgumentParser, argv: Sequence[str] | None) -> 
     finally:
         for sig, h in old_handlers.items():
             signal.signal(sig, h)
+        clear_interrupt()  # a signal of this command must not interrupt the caller's next step (tests, a library)
         warnings.filters[:] = saved_warnings
         np.seterr(**saved_np)
 

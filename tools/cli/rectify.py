@@ -118,7 +118,11 @@ def load_any_maps(path: str):
         return load_maps(p)
     if p.suffix.lower() == ".npz":
         raise ValueError(f"{p} is not a readable .npz maps file")
-    return maps_from_poly(p)
+    try:
+        return maps_from_poly(p)
+    except ValueError as e:  # e.g. polynomials that overflow to inf: name the file
+        text = str(e)
+        raise ValueError(text if str(p) in text else f"{p}: {text}") from None
 
 
 #: Image formats ``warp`` writes, by suffix, and the pixel depths each can hold.
@@ -156,6 +160,16 @@ def cmd_warp(args: argparse.Namespace) -> int:
     print(f"{args.side} image {img.shape[1]}x{img.shape[0]} ({depth}) rectified to {rect.shape[1]}x{rect.shape[0]} "
           f"-> {args.output}")
     return 0
+
+
+def c_prefix(text: str) -> str:
+    """A C name prefix for ``lut`` (:func:`eyestereo.tools.rectify.lut.check_prefix`), as an argparse type."""
+    from eyestereo.tools.rectify.lut import check_prefix
+
+    try:
+        return check_prefix(text)
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
 
 
 def cmd_lut(args: argparse.Namespace) -> int:
@@ -249,7 +263,8 @@ def register(sub: Any) -> None:
     p.add_argument("maps", metavar="MAPS", help="maps.npz or poly.json")
     p.add_argument("--frac-bits", type=int, choices=range(0, 15), default=5, metavar="0..14",
                    help="fraction bits of the int16 codes (default 5)")
-    p.add_argument("--prefix", default="eyestereo_lut", help="C name prefix (default eyestereo_lut)")
+    p.add_argument("--prefix", type=c_prefix, default="eyestereo_lut",
+                   help="C name prefix: a C identifier, no keyword, not starting with _ (default eyestereo_lut)")
     p.add_argument("-o", "--output", required=True, help="header to write (.h)")
     p.set_defaults(func=cmd_lut)
 

@@ -10,13 +10,18 @@ State: ``rw`` (stored word per rw register), ``arrays`` (stored words per array,
 (port -> function(index) -> word: what the external read port answers), ``sram`` (word address ->
 16-bit word). ``events`` lists, in order, what writes caused on the ports: ``("pulse", field)`` for a
 one-clock pulse and ``("write", port, index, data)`` for a write-port write.
+
+User values are checked, not masked: ``width``/``height`` as the VHDL block checks them
+(:func:`eyestereo.tools.regmap.check_frame_size`), :meth:`RegisterBank.set_input` against the field
+(:meth:`eyestereo.tools.regmap.Field.check`). The bus side stays the hardware's: a bus write carries 32
+bits, and the bank keeps the bits its strobes and fields select.
 """
 
 from __future__ import annotations
 
 from typing import Callable
 
-from eyestereo.tools.regmap import OKAY, REGMAP, SLVERR, WRITABLE, RegisterMap
+from eyestereo.tools.regmap import OKAY, REGMAP, SLVERR, WRITABLE, RegisterMap, check_frame_size
 
 __all__ = ["RegisterBank", "strobe_mask"]
 
@@ -29,11 +34,18 @@ def strobe_mask(strb: int) -> int:
 
 
 class RegisterBank:
-    """The register bank's behaviour (see the module docstring); ``width``/``height`` are its parameters."""
+    """The register bank's behaviour (see the module docstring); ``width``/``height`` are its parameters.
+
+    ``width``/``height`` must be integers in 2..4096 (:func:`eyestereo.tools.regmap.check_frame_size`, the
+    rule the VHDL block elaborates with): the model refuses what the block refuses, with the same
+    ValueError (without the block's name in front), so a bench cannot check the VHDL against a model of
+    a bank that cannot be built.
+    """
 
     def __init__(self, regmap: RegisterMap = REGMAP, *, width: int = 352, height: int = 288):
         self.regmap = regmap
-        self.params = dict(width=int(width), height=int(height))
+        width, height = check_frame_size(width, height)
+        self.params = dict(width=width, height=height)
         self.inputs: dict[str, int] = {f.name: 0 for r in regmap.of_kind("status") for f in r.fields}
         self.windows: dict[str, Callable[[int], int]] = {r.port: (lambda i: 0) for r in regmap.of_kind("window")}
         self.sram: dict[int, int] = {}
@@ -55,10 +67,13 @@ class RegisterBank:
         return out
 
     def set_input(self, name: str, value: int) -> None:
+        """Drive the status input port of field ``name`` with ``value``: an integer that fits the field's
+        port (0..2**width-1; :meth:`~eyestereo.tools.regmap.Field.check`), else ValueError, e.g.
+        ``FEATURES.features_right: 131071 does not fit (0..65535, 16 bits)`` (a port has no bits for more)."""
         r, f = self.regmap.field(name)
         if r.kind != "status":
             raise KeyError(f"field {name} is not a status input")
-        self.inputs[f.name] = int(value) & ((1 << f.width) - 1)
+        self.inputs[f.name] = f.check(value, f"{r.name}.{f.name}")
 
     # ---- bus ---------------------------------------------------------------------------------------
     def write(self, address: int, data: int, strb: int = 0xF) -> int:

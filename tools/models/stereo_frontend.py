@@ -48,6 +48,10 @@ def stereo_frontend(cal: Calibration, left_words, right_words, k, thresholds, *,
     ``left_words``/``right_words``: camera words (height x width); ``k``: a code or (left, right);
     ``thresholds``: 16 codes or (left 16, right 16). Returns ``rectified`` (left, right), ``rect_words``,
     ``flags`` (left, right, mask), ``list`` (the feature_list model's dict) and ``list_words``.
+
+    ``nms``, ``border``, ``max_features``, ``frac``: the top's parameters of those names, with its defaults
+    (tests/models/test_stereo_models.py checks them against its signature); a top built otherwise is
+    modelled only with the same values (the bench's ``model_params``): ``max_features`` cuts the list.
     """
     gl, gr = grey(left_words), grey(right_words)
     rl, rr = rect_model.rectifier(cal, gl, gr, frac)

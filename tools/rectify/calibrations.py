@@ -10,7 +10,8 @@ into such a document (checked by :func:`~eyestereo.tools.rectify.ffc.read_quanti
     352x288, k1 about -0.3, about 1 degree of misalignment), converted with the default bound
     (mse 0.01 px^2 per polynomial). The repository rebuilds it from nothing in a few seconds.
 ``"rig:WxH"``
-    The same rig at another rectified size (the geometry scales with the width).
+    The same rig at another rectified size (the geometry scales with the width); W and H are 2..4096
+    (the hardware's frame limit, :data:`MAX_SIDE`), also in ``seed:...@WxH``.
 ``"seed:N[:SPREAD][@WxH]"``
     A random EyeBot-like rig: :func:`eyestereo.tools.rectify.rig.eyebot_rig` with its rotation, principal
     points, focal lengths, lens distortion and baseline direction perturbed by seed ``N`` (``SPREAD`` scales
@@ -57,7 +58,7 @@ from eyestereo.tools.rectify.ffc import (
     run_ffc,
 )
 
-__all__ = ["DEFAULT_SPEC", "cache_dir", "load", "seeded_rig", "shared_data_dir"]
+__all__ = ["DEFAULT_SPEC", "MAX_SIDE", "cache_dir", "load", "seeded_rig", "shared_data_dir"]
 
 DEFAULT_SPEC = "rig"
 #: Bump when a generator below changes what it builds (invalidates the cache).
@@ -81,12 +82,19 @@ def shared_data_dir() -> Path:
     return Path(env) if env else _ROOT.parent / "shared" / "data"
 
 
+#: The sides a generated calibration may have: the rectifier hardware's frame limit (the fetch port's
+#: 2..4096, the blocks' counters up to 4096: ``hdl/fetch_port.py``, ``hdl/common/checks.py``), checked
+#: before anything is built or allocated.
+MIN_SIDE, MAX_SIDE = 2, 4096
+
+
 def _size(text: str | None, default: tuple[int, int]) -> tuple[int, int]:
     if not text:
         return default
-    m = re.fullmatch(r"(\d+)x(\d+)", text)
-    if not m or int(m.group(1)) < 2 or int(m.group(2)) < 2:
-        raise ValueError(f"bad size {text!r}: want WxH with W, H >= 2")
+    m = re.fullmatch(r"(\d{1,9})x(\d{1,9})", text)
+    if not m or not all(MIN_SIDE <= int(v) <= MAX_SIDE for v in m.groups()):
+        raise ValueError(f"bad size {text!r}: want WxH with {MIN_SIDE}..{MAX_SIDE} pixels a side (the rectifier "
+                         f"hardware's frame limit)")
     return int(m.group(1)), int(m.group(2))
 
 

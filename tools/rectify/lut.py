@@ -19,7 +19,9 @@ Codes are ``floor(v * 2^FRAC_BITS + 0.5)`` (round half up) of the 0-based source
 to -32767..32767 (saturated codes lie far outside the image, so a reader still sees them as out of
 range). Five fraction bits are the thesis's choice for coordinates (ufix[14,5], thesis 4); they
 leave +-1023 pixels of range, enough for images up to 1024 pixels wide, and ``frac_bits`` can be
-lowered for larger ones.
+lowered for larger ones. The prefix must give usable C names (:func:`check_prefix`: no keyword, no
+reserved ``_`` name, no clash with a standard macro). Map entries may be NaN (no source pixel:
+``INVALID``) but not infinite (:func:`~eyestereo.tools.rectify.maps.check_map_entries`).
 """
 
 from __future__ import annotations
@@ -31,9 +33,9 @@ from pathlib import Path
 import numpy as np
 
 from eyestereo.tools.io import atomic_output
-from eyestereo.tools.rectify.maps import MAP_KEYS, Maps
+from eyestereo.tools.rectify.maps import MAP_KEYS, Maps, check_map_entries
 
-__all__ = ["INT16_INVALID", "create_c_lut", "lut_codes"]
+__all__ = ["INT16_INVALID", "check_prefix", "create_c_lut", "lut_codes"]
 
 INT16_INVALID = -32768
 _INT16_MAX = 32767
@@ -48,6 +50,45 @@ def lut_codes(values: np.ndarray, frac_bits: int = 5) -> np.ndarray:
     return np.where(finite, codes, np.int16(INT16_INVALID)).astype(np.int16)
 
 
+#: C's keywords, C89 to C23 (those starting with ``_`` are refused as reserved names anyway).
+C_KEYWORDS = frozenset("""
+    auto break case char const continue default do double else enum extern float for goto if inline int long
+    register restrict return short signed sizeof static struct switch typedef union unsigned void volatile while
+    alignas alignof bool constexpr false nullptr static_assert thread_local true typeof typeof_unqual
+""".split())
+#: Prefixes ``P`` whose ``P_WIDTH`` is a macro of C23's ``<stdint.h>`` (which the header includes; glibc
+#: also defines them with ``_GNU_SOURCE``) or ``<limits.h>``: the header would redefine it.
+_STD_WIDTH = re.compile(r"U?INT(_LEAST|_FAST)?(8|16|32|64)|U?INT(PTR|MAX)|PTRDIFF|SIG_ATOMIC|SIZE|WCHAR|WINT"
+                        r"|BOOL|[SU]?CHAR|U?SHRT|U?INT|U?L?LONG")
+#: Longest prefix: C99 compilers need tell apart only the first 63 characters of a name, and the
+#: longest generated name (``P_SOURCE_HEIGHT``) adds 14.
+MAX_PREFIX = 49
+
+
+def check_prefix(prefix: str) -> str:
+    """``prefix`` if the names the header makes of it (``prefix_left_x``, ``PREFIX_WIDTH``, ...) are
+    usable C names; else ValueError with the reason, in one line.
+
+    Refused: anything that is not a C identifier, longer than :data:`MAX_PREFIX` characters, a C keyword,
+    a name starting with ``_`` (the tables are file-scope and the macros upper-case, so every name made
+    of it would be reserved for the compiler and the C library), and prefixes whose ``PREFIX_WIDTH`` is a
+    standard macro (``int8`` -> ``INT8_WIDTH`` of ``<stdint.h>``)."""
+    if not isinstance(prefix, str) or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", prefix):
+        raise ValueError(f"prefix must be a C identifier (a letter, then letters, digits or _), got {prefix!r}")
+    if len(prefix) > MAX_PREFIX:
+        raise ValueError(f"prefix {prefix[:16]}... has {len(prefix)} characters; at most {MAX_PREFIX}, so that every "
+                         f"name made of it stays within the 63 characters C compilers must tell apart")
+    if prefix in C_KEYWORDS:
+        raise ValueError(f"prefix {prefix!r} is a C keyword; give a name such as {prefix}_lut")
+    if prefix.startswith("_"):
+        raise ValueError(f"prefix {prefix!r} starts with '_': the names made of it ({prefix}_left_x, "
+                         f"{prefix.upper()}_WIDTH) are reserved for the C compiler and library")
+    if _STD_WIDTH.fullmatch(prefix.upper()):
+        raise ValueError(f"prefix {prefix!r} would define {prefix.upper()}_WIDTH, a standard C macro (<stdint.h>, "
+                         f"<limits.h>); give a name such as {prefix}_lut")
+    return prefix
+
+
 def _guard(path: Path) -> str:
     g = re.sub(r"[^A-Za-z0-9]", "_", path.name).upper()
     return ("_" + g) if g[0].isdigit() else g
@@ -58,11 +99,12 @@ def create_c_lut(maps: Maps, path: str | os.PathLike[str], *, frac_bits: int = 5
     """Write the four backward tables of ``maps`` as a C header (format in the module docstring). Atomic.
 
     ``guard``: the file name the include guard is made from (default: ``path``'s name; give the final
-    name when ``path`` is a temporary)."""
-    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", prefix):
-        raise ValueError(f"prefix must be a C identifier, got {prefix!r}")
+    name when ``path`` is a temporary). ValueError, before anything is written, for a ``prefix`` that
+    :func:`check_prefix` refuses or a map with an infinite entry."""
+    check_prefix(prefix)
     if not 0 <= frac_bits <= 14:
         raise ValueError(f"frac_bits must be 0..14, got {frac_bits}")
+    check_map_entries(maps)
     src_w, src_h = maps.source_size or (maps.width, maps.height)
     if (max(src_w, src_h) - 1) * (1 << frac_bits) > _INT16_MAX:
         raise ValueError(f"{src_w}x{src_h} images need coordinates beyond int16 with {frac_bits} "
@@ -71,7 +113,7 @@ def create_c_lut(maps: Maps, path: str | os.PathLike[str], *, frac_bits: int = 5
     g = Path(guard) if guard is not None else p
     P = prefix.upper()
     lines = [
-        f"/* Backward rectification look-up tables, written by eyestereo (Rectification Toolbox). */",
+        "/* Backward rectification look-up tables, written by eyestereo (Rectification Toolbox). */",
         f"/* entry [y * {P}_WIDTH + x] = source coordinate * 2^{P}_FRAC_BITS, 0-based pixels. */",
         f"#ifndef {_guard(g)}",
         f"#define {_guard(g)}",

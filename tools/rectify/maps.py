@@ -69,6 +69,7 @@ __all__ = [
     "Maps",
     "backward_map",
     "BUDGET_GROUPS",
+    "check_map_entries",
     "compare_up_to_frame",
     "compute_maps",
     "distort",
@@ -296,6 +297,7 @@ class Maps:
             elif a.shape != shape:
                 raise ValueError(f"map {k} has shape {a.shape} but left_x has {shape}")
             setattr(self, k, a)
+        check_map_entries(self)
 
     @property
     def width(self) -> int:
@@ -317,6 +319,24 @@ class Maps:
         if side not in ("left", "right"):
             raise ValueError(f"side must be 'left' or 'right', got {side!r}")
         return getattr(self, f"{side}_x"), getattr(self, f"{side}_y")
+
+
+def check_map_entries(maps: Maps) -> None:
+    """ValueError, in one line, if a map of ``maps`` holds an infinite entry.
+
+    A map entry is a source coordinate, or NaN for a rectified pixel without a source pixel (the fit skips
+    it, ``warp`` makes it black, the C table writes ``INVALID``); +-inf is neither (a division by zero
+    somewhere upstream) and is refused, naming each array with the count and the first position."""
+    parts = []
+    for k in MAP_KEYS:
+        bad = np.isinf(np.asarray(getattr(maps, k)))
+        n = int(np.count_nonzero(bad))
+        if n:
+            y, x = divmod(int(np.argmax(bad)), bad.shape[1])
+            parts.append(f"map {k} holds {n} infinite entr{'y' if n == 1 else 'ies'} (the first at x={x}, y={y})")
+    if parts:
+        raise ValueError(f"{', '.join(parts)}: a map entry is a source coordinate, or NaN for a pixel without "
+                         f"a source")
 
 
 def compute_maps(calib: StereoCalibration, *, method: str = "thesis", size: tuple[int, int] | None = None,
@@ -550,7 +570,10 @@ def save_maps(maps: Maps, path: str | os.PathLike[str]) -> None:
 
 
 def load_maps(path: str | os.PathLike[str]) -> Maps:
-    """Read a maps file written by :func:`save_maps` (or any npz with the four float map arrays)."""
+    """Read a maps file written by :func:`save_maps` (or any npz with the four float map arrays).
+
+    Map entries may be NaN (no source pixel) but not infinite (:func:`check_map_entries`); ``K``, ``R1``,
+    ``R2``, ``P1``, ``P2`` must be finite. ValueError naming the file otherwise."""
     p = Path(path)
     if not p.is_file():
         raise ValueError(f"maps file {p} does not exist")
@@ -567,6 +590,8 @@ def load_maps(path: str | os.PathLike[str]) -> Maps:
         if k in data:
             if data[k].shape != shape:
                 raise ValueError(f"{p}: {k} must have shape {shape}, got {data[k].shape}")
+            if not np.issubdtype(data[k].dtype, np.number) or not np.all(np.isfinite(data[k])):
+                raise ValueError(f"{p}: {k} must hold finite numbers")
             opt[k] = data[k].astype(np.float64)
     if "image_size" in data:
         s = data["image_size"]

@@ -39,7 +39,7 @@ import numpy as np
 
 from eyestereo.tools.io import atomic_output
 from eyestereo.tools.progress import progress_bar
-from eyestereo.tools.rectify.maps import MAP_KEYS, Maps
+from eyestereo.tools.rectify.maps import MAP_KEYS, Maps, check_map_entries
 
 __all__ = [
     "DEGREES",
@@ -173,8 +173,12 @@ def _side_stats(ex: dict[str, np.ndarray], ey: dict[str, np.ndarray]) -> dict[st
 
 
 def fit(maps: Maps, degree: int = 3, mask: np.ndarray | None = None) -> Fit:
-    """Least-squares polynomials of ``degree`` for the four maps (all finite pixels, or ``mask``)."""
+    """Least-squares polynomials of ``degree`` for the four maps (all finite pixels, or ``mask``).
+
+    NaN entries (no source pixel) are left out; an infinite entry is refused (ValueError naming the
+    array and the count, :func:`~eyestereo.tools.rectify.maps.check_map_entries`)."""
     degree = _check_degree(degree)
+    check_map_entries(maps)
     h, w = maps.height, maps.width
     if w * h < len(terms(degree)):
         raise ValueError(f"a {w}x{h} map has too few pixels for a degree-{degree} fit")
