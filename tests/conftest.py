@@ -11,3 +11,21 @@ def pytest_collection_modifyitems(config, items):
             items[:] = keep
     # The GHDL benches are the slow part: start them first so the 2 workers finish together.
     items.sort(key=lambda it: 0 if (it.get_closest_marker("sim") or it.get_closest_marker("othersims")) else 1)
+
+
+@pytest.fixture
+def tsukuba_pair(tmp_path):
+    """``make(rows, cols, shift)``: a stereo pair cut from tests/data/tsukuba_im3.png (the right view
+    ``shift`` pixels further), written as ``l.png`` / ``r.png`` in the test's folder; returns their paths."""
+    from pathlib import Path
+
+    import cv2
+
+    img = cv2.imread(str(Path(__file__).resolve().parent / "data" / "tsukuba_im3.png"), cv2.IMREAD_GRAYSCALE)
+
+    def make(rows: slice, cols: slice, shift: int):
+        cv2.imwrite(str(tmp_path / "l.png"), img[rows, cols])
+        cv2.imwrite(str(tmp_path / "r.png"), img[rows, cols.start + shift:cols.stop + shift])
+        return tmp_path / "l.png", tmp_path / "r.png"
+
+    return make

@@ -21,11 +21,8 @@ def run(capfd, *argv):
 
 
 @pytest.fixture
-def pair(tmp_path):
-    img = cv2.imread(str(DATA / "tsukuba_im3.png"), cv2.IMREAD_GRAYSCALE)
-    cv2.imwrite(str(tmp_path / "l.png"), img[100:196, 150:278])
-    cv2.imwrite(str(tmp_path / "r.png"), img[100:196, 156:284])
-    return tmp_path / "l.png", tmp_path / "r.png"
+def pair(tsukuba_pair):
+    return tsukuba_pair(slice(100, 196), slice(150, 278), 6)
 
 
 @pytest.mark.sim

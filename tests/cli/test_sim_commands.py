@@ -47,11 +47,8 @@ def tree(folder: Path) -> dict:
 
 
 @pytest.fixture
-def pair(tmp_path):
-    img = cv2.imread(str(DATA / "tsukuba_im3.png"), cv2.IMREAD_GRAYSCALE)
-    cv2.imwrite(str(tmp_path / "l.png"), img[120:140, 160:190])
-    cv2.imwrite(str(tmp_path / "r.png"), img[120:140, 166:196])
-    return tmp_path / "l.png", tmp_path / "r.png"
+def pair(tsukuba_pair):
+    return tsukuba_pair(slice(120, 140), slice(160, 190), 6)
 
 
 # ---- output folders -----------------------------------------------------------------------------
