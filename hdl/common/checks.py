@@ -34,8 +34,8 @@ import numpy as np
 from myhdl import ResetSignal, intbv
 from myhdl._Signal import _Signal
 
-from eyestereo.hdl.axis import AxiStream
-from eyestereo.hdl.stream import ImageStream
+from eyestereo.hdl.interfaces.axis import AxiStream
+from eyestereo.hdl.interfaces.stream import ImageStream
 
 __all__ = ["check_axis", "check_clock", "check_reset", "check_stream", "check_signal", "check_int", "check_choice",
            "check_bool", "check_frame", "check_distinct", "block_error", "checked"]
@@ -149,7 +149,7 @@ def check_signal(name: str, sig, *, width: int | None = None, signed: bool | Non
 
 
 def check_stream(name: str, stream, *, width: int | None = None, stereo: bool | None = False) -> None:
-    """An :class:`~eyestereo.hdl.stream.ImageStream` port of ``width`` data bits.
+    """An :class:`~eyestereo.hdl.interfaces.stream.ImageStream` port of ``width`` data bits.
 
     ``stereo``: False (default) = mono only, a stereo stream is refused; True = must be stereo;
     None = either kind (blocks that forward ``cam``; check the source with ``stereo=sink.stereo``).
@@ -176,7 +176,7 @@ def check_stream(name: str, stream, *, width: int | None = None, stereo: bool | 
 
 
 def check_axis(name: str, port, *, data_width: int | None = None) -> None:
-    """An :class:`~eyestereo.hdl.axis.AxiStream` port carrying ``data_width``-bit pixels."""
+    """An :class:`~eyestereo.hdl.interfaces.axis.AxiStream` port carrying ``data_width``-bit pixels."""
     if not isinstance(port, AxiStream):
         raise _fail(f"port {name} must be an AxiStream, got {_what(port)}")
     for f in port.fields():

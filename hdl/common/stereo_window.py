@@ -1,10 +1,10 @@
 """Window machinery for stereo streams: one datapath, two cameras (thesis 6.3, Figs. 6.14-6.16).
 
-A stereo stream (:mod:`eyestereo.hdl.stream`) carries the left and the right pixel of each (x, y) in
+A stereo stream (:mod:`eyestereo.hdl.interfaces.stream`) carries the left and the right pixel of each (x, y) in
 turn. The filters of the stereo Harris detector process both cameras in one datapath:
 
 * :func:`stereo_column_taps` -- like :func:`~eyestereo.hdl.common.window.column_taps`, but its line
-  delays are stereo :func:`~eyestereo.hdl.line_delay.line_delay` blocks (2 x width words addressed by
+  delays are stereo :func:`~eyestereo.hdl.streaming.line_delay.line_delay` blocks (2 x width words addressed by
   (column, cam)): both cameras share each block RAM, so a stereo filter needs no more block RAMs than a
   mono one with the same total number of words.
 * :func:`pair_chain` -- the horizontal registers of a window: 2N - 1 registers shifted on every pixel
@@ -15,7 +15,7 @@ turn. The filters of the stereo Harris detector process both cameras in one data
   after the frame's last pixel (left, right, left, ...), one beat every ``share`` clocks so that the
   time-shared multipliers behind it always see beats at least ``share`` clocks apart.
 
-Helpers, not stream blocks: used by :func:`eyestereo.hdl.harris_stereo.harris_stereo`.
+Helpers, not stream blocks: used by :func:`eyestereo.hdl.harris.harris_stereo.harris_stereo`.
 """
 
 from myhdl import Signal, always_comb, always_seq, block, intbv
@@ -23,8 +23,8 @@ from myhdl import Signal, always_comb, always_seq, block, intbv
 from eyestereo.hdl.common.checks import (block_error, check_clock, check_frame, check_int, check_reset,
                                          check_signal, check_stream)
 from eyestereo.hdl.common.registers import assign, delay, delay_rst, en_reg, like_signal
-from eyestereo.hdl.line_delay import line_delay
-from eyestereo.hdl.stream import ImageStream
+from eyestereo.hdl.streaming.line_delay import line_delay
+from eyestereo.hdl.interfaces.stream import ImageStream
 
 
 @block

@@ -2,7 +2,7 @@
 
 A filter is assembled from three parts:
 
-* :func:`column_taps` -- N-1 chained :func:`~eyestereo.hdl.line_delay.line_delay` blocks and alignment
+* :func:`column_taps` -- N-1 chained :func:`~eyestereo.hdl.streaming.line_delay.line_delay` blocks and alignment
   registers: N pixels of one image column (rows y-r .. y+r), all valid in the same clock.
 * arithmetic on the taps, by :func:`~eyestereo.hdl.common.arith.shift_add` (constant coefficients as shifts and adds) and plain
   registers, free-running: it needs no enable, because the control path carries the timing.
@@ -13,7 +13,7 @@ A filter is assembled from three parts:
   needed. Those pixels, and all others whose window leaves the image, carry unspecified data.
 
 These are helpers, not stream blocks: they are instantiated inside blocks such as
-:func:`~eyestereo.hdl.convolve.convolve` and :func:`~eyestereo.hdl.sobel.sobel`.
+:func:`~eyestereo.hdl.streaming.convolve.convolve` and :func:`~eyestereo.hdl.harris.sobel.sobel`.
 """
 
 from myhdl import Signal, always_comb, always_seq, block, intbv
@@ -21,8 +21,8 @@ from myhdl import Signal, always_comb, always_seq, block, intbv
 from eyestereo.hdl.common.checks import (block_error, check_clock, check_frame, check_int, check_reset,
                                          check_signal, check_stream)
 from eyestereo.hdl.common.registers import assign, delay, delay_rst
-from eyestereo.hdl.line_delay import line_delay
-from eyestereo.hdl.stream import ImageStream
+from eyestereo.hdl.streaming.line_delay import line_delay
+from eyestereo.hdl.interfaces.stream import ImageStream
 
 
 @block

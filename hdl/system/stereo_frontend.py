@@ -1,0 +1,234 @@
+"""The stereo front end: two cameras -> SRAM -> rectifier -> stereo Harris -> feature lists, on an AXI4-Lite bus (thesis Fig. 7.2)."""
+
+from __future__ import annotations
+
+from myhdl import Signal, always_comb, always_seq, block, concat, intbv
+
+from eyestereo.hdl.streaming.async_fifo import MAX_DEPTH
+from eyestereo.hdl.interfaces.axil import check_axil
+from eyestereo.hdl.camera.camera_stream import check_camera
+from eyestereo.hdl.camera.camera_interface import camera_pair
+from eyestereo.hdl.common.checks import block_error, check_choice, check_clock, check_int, check_reset
+from eyestereo.hdl.harris.feature_list import addr_bits, count_bits, feature_list
+from eyestereo.hdl.rectify.fetch_interpolate import DEFAULT_DEPTH
+from eyestereo.hdl.interfaces.fetch_port import FetchPort
+from eyestereo.hdl.memory.frame_buffers import FrameControl
+from eyestereo.hdl.system.frontend_sequencer import frontend_sequencer
+from eyestereo.hdl.harris.harris_stereo import harris_stereo
+from eyestereo.hdl.rectify.poly_unit import calibration_param
+from eyestereo.hdl.interfaces.queue import QueuePort
+from eyestereo.hdl.rectify.rectifier import rectifier
+from eyestereo.hdl.system.register_bank import RegisterPorts, register_bank
+from eyestereo.hdl.interfaces.sram_bus import HostPort, SramPins, StatPort, check_bundle
+from eyestereo.hdl.memory.sram_subsystem import sram_subsystem
+from eyestereo.hdl.interfaces.stream import ImageStream
+from eyestereo.hdl.streaming.stream_cdc import stream_cdc
+from eyestereo.hdl.streaming.word_cdc import word_cdc
+from eyestereo.tools.models import poly_unit as unit_model
+from eyestereo.tools.models.sram_arbiter import CAMERA_WORD
+from eyestereo.tools.camera import ORDERS
+from eyestereo.tools.regmap import REGMAP
+from eyestereo.tools.sram import KINDS
+
+__all__ = ["stereo_frontend", "BLOCKS", "THR_BITS"]
+
+#: Threshold blocks per camera: the register map's 16 thresholds and 32 per-block counts.
+BLOCKS = (4, 4)
+THR_BITS = REGMAP["THR_LEFT"].fields[0].width
+
+
+@block
+def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sram, *, quantizers="rig",
+                    frac: int | None = unit_model.DEFAULT_FRAC, nms: int = 3, share: int = 1, border: int | None = None,
+                    max_features: int = 1023, feature_words: int = 2048, cam_depth: int = 1024,
+                    kind: str = "nobl", read_latency: int = 2, order: str = "YUYV", rect_depth: int = DEFAULT_DEPTH):
+    """The complete stereo front end of the thesis's Fig. 7.2, with the processor's register bus.
+
+    Data flow: each camera bus -> :func:`~eyestereo.hdl.camera.camera_interface.camera_pair` (converter and
+    async FIFO into the memory clock) -> its double-buffered frame in the SRAM (the arbiter's camera
+    writers). When both frames of a pair are in, :func:`~eyestereo.hdl.system.frontend_sequencer.frontend_sequencer`
+    starts the :func:`~eyestereo.hdl.rectify.rectifier.rectifier`, which reads them through the arbiter's fetch
+    port; its 8-bit stereo stream goes both into the rectified-image buffers (the arbiter's rect writer:
+    left and right pixel of (x, y) in one word) and, through a
+    :func:`~eyestereo.hdl.streaming.stream_cdc.stream_cdc`, into :func:`~eyestereo.hdl.harris.harris_stereo.harris_stereo`
+    in the Harris clock. Its corner flags come back through a second stream_cdc into the memory clock,
+    where :func:`~eyestereo.hdl.harris.feature_list.feature_list` makes the feature words (the arbiter's feature
+    writer) and the per-block counts (the register bank's FCOUNT window, read directly). k (a
+    :func:`~eyestereo.hdl.streaming.word_cdc.word_cdc`) and the block thresholds (one-beat frames of 25 bits: camera,
+    block, code, through a stream_cdc) cross into the Harris clock; the crossing's dropped-frame count
+    comes back through a word_cdc. The :func:`~eyestereo.hdl.system.register_bank.register_bank` (AXI4-Lite,
+    the register map of eyestereo.tools.regmap) runs in the memory clock: the processor's bus must be
+    in that clock (no AXI clock converter inside).
+
+    Ports:
+        clk, rst: the memory clock (100 MHz: SRAM, arbiter, rectifier, feature list, register bus) and
+            its synchronous active-high reset.
+        hclk, hrst: the Harris clock (50 MHz in the thesis; harris_stereo share 1 takes a beat per clock,
+            so any hclk of at least half the memory clock keeps up with the rectifier) and its reset.
+        cam_l, wrst_l, cam_r, wrst_r: the camera buses (:class:`~eyestereo.hdl.interfaces.camera_bus.CameraBus`,
+            each clocked by its own PCLK) and each camera domain's synchronous reset.
+        bus: :class:`~eyestereo.hdl.interfaces.axil.AxiLite` slave (the register map's address bits), memory clock.
+        sram: :class:`~eyestereo.hdl.interfaces.sram_bus.SramPins`.
+
+    Parameters:
+        quantizers, frac: the calibration (a spec such as ``"rig:64x48"``, a quantizers.json or a
+            Calibration; its rectified size must equal its camera size: the frame buffers are one size),
+            as for the rectifier. The frame size is the calibration's.
+        nms, share: harris_stereo's (default share 1: a beat per Harris clock).
+        border: feature_list's border (default harris_stereo's r = 3 + nms // 2).
+        max_features, feature_words: features per list and the SRAM words of each list buffer.
+        cam_depth: each camera FIFO's entries (1024 = one RAMB16).
+        kind, read_latency: the SRAM part (sram_controller).
+        order: the cameras' byte order.
+        rect_depth: fetch_interpolate's sides in flight.
+
+    Latency: a frame's features are complete a few lines (Harris's lead, :func:`harris_stereo.latency`)
+    after the rectifier's last beat; the sequencer's ``frame_clocks`` measures the whole.
+
+    Resources: the sum of the blocks (docs/system.md: Yosys, Spartan-3E 500).
+    """
+    check_clock(clk)
+    check_reset(rst)
+    check_clock(hclk, "hclk")
+    check_reset(hrst, "hrst")
+    check_camera("cam_l", cam_l)
+    check_camera("cam_r", cam_r)
+    check_reset(wrst_l, "wrst_l")
+    check_reset(wrst_r, "wrst_r")
+    check_axil("bus", bus, addr_bits=REGMAP.addr_bits)
+    check_bundle("sram", sram, SramPins)
+    cal = calibration_param(quantizers, None, None)
+    if (cal.width, cal.height) != (cal.source_width, cal.source_height):
+        raise block_error(f"parameter quantizers: the calibration rectifies {cal.source_width}x{cal.source_height} "
+                          f"camera images to {cal.width}x{cal.height}; the front end's buffers need one size")
+    width, height = cal.width, cal.height
+    nms = check_choice("nms", nms, (1, 3, 5))
+    share = check_choice("share", share, (1, 2, 3))
+    if share != 1:
+        raise block_error(f"parameter share={share}: the rectifier's stream comes up to a beat every 2 Harris "
+                          "clocks with no back-pressure; only share 1 takes it")
+    border = 3 + nms // 2 if border is None else check_int("border", border, 1)
+    max_features = check_int("max_features", max_features, 1, 32767)
+    feature_words = check_int("feature_words", feature_words, 2, 65536)
+    if feature_words < 2 * max_features + 2:
+        raise block_error(f"parameter feature_words={feature_words}: a list of {max_features} features and its "
+                          f"trailer need {2 * max_features + 2} words")
+
+    cam_depth = check_int("cam_depth", cam_depth, 4, MAX_DEPTH)
+    if cam_depth & (cam_depth - 1):
+        raise block_error(f"parameter cam_depth={cam_depth} must be a power of two (the camera FIFOs)")
+    kind = check_choice("kind", kind, KINDS)
+    read_latency = check_int("read_latency", read_latency, 1, 3)
+    order = check_choice("order", order, ORDERS)
+    rect_depth = check_int("rect_depth", rect_depth, 1, 16)
+    if frac is not None:
+        frac = check_int("frac", frac, 0, unit_model.MAX_FRAC)
+
+    insts = []
+    # ---- cameras into the memory clock ---------------------------------------------------------
+    cam0, cam1 = QueuePort(CAMERA_WORD), QueuePort(CAMERA_WORD)
+    dropped_l, dropped_r = Signal(intbv(0)[16:]), Signal(intbv(0)[16:])
+    insts.append(camera_pair(cam_l, wrst_l, cam_r, wrst_r, clk, rst, cam0, cam1, dropped_l, dropped_r,
+                             width=width, height=height, order=order, depth=cam_depth))
+
+    # ---- SRAM subsystem and register bank --------------------------------------------------------
+    fetch = FetchPort(width, height)
+    rect = ImageStream(8, stereo=True)
+    feat = QueuePort(16)
+    host, stat, ctl = HostPort(), StatPort(), FrameControl()
+    fcount = StatPort(5, 16)
+    regs = RegisterPorts()
+    insts.append(sram_subsystem(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, sram, kind=kind,
+                                read_latency=read_latency, width=width, height=height, feature_words=feature_words))
+    insts.append(register_bank(clk, rst, bus, regs, stat, fcount, host, width=width, height=height))
+
+    # ---- rectifier and sequencer -----------------------------------------------------------------
+    r_start, r_busy = Signal(bool(0)), Signal(bool(0))
+    insts.append(rectifier(clk, rst, r_start, fetch, rect, r_busy, quantizers=cal, frac=frac, depth=rect_depth))
+    l_done, l_ovf = Signal(bool(0)), Signal(bool(0))
+    insts.append(frontend_sequencer(clk, rst, regs.mode, regs.continuous, regs.start, regs.stop, ctl, r_start,
+                                    r_busy, l_done, l_ovf, regs.busy, regs.frames, regs.frame_clocks,
+                                    regs.list_overflows))
+
+    # ---- into the Harris clock and back --------------------------------------------------------------
+    h_in = ImageStream(8, stereo=True)
+    h_dropped, h_dropped_m = Signal(intbv(0)[16:]), Signal(intbv(0)[16:])
+    insts.append(stream_cdc(clk, rst, rect, hclk, hrst, h_in, h_dropped, depth=16))
+    insts.append(word_cdc(hclk, h_dropped, clk, h_dropped_m))
+
+    k_m, k_h = Signal(intbv(0)[16:]), Signal(intbv(0)[16:])
+    k_l_h, k_r_h = Signal(intbv(0)[8:]), Signal(intbv(0)[8:])
+    insts.append(word_cdc(clk, k_m, hclk, k_h))
+    tbits = 1 + 4 + THR_BITS
+    thr_m, thr_h = ImageStream(tbits), ImageStream(tbits)
+    thr_dropped = Signal(intbv(0)[16:])
+    insts.append(stream_cdc(clk, rst, thr_m, hclk, hrst, thr_h, thr_dropped, depth=16))
+    thr_we, thr_cam = Signal(bool(0)), Signal(bool(0))
+    thr_addr, thr_data = Signal(intbv(0)[4:]), Signal(intbv(0)[THR_BITS:])
+
+    @always_comb
+    def to_harris_m():
+        k_m.next = concat(regs.k_right, regs.k_left)
+        thr_m.valid.next = regs.thr_left_we or regs.thr_right_we
+        thr_m.eol.next = 1
+        thr_m.eof.next = 1
+        if regs.thr_left_we:
+            thr_m.data.next = concat(False, regs.thr_left_addr, regs.thr_left_data)
+        else:
+            thr_m.data.next = concat(True, regs.thr_right_addr, regs.thr_right_data)
+
+    @always_comb
+    def to_harris_h():
+        k_l_h.next = k_h[8:0]
+        k_r_h.next = k_h[16:8]
+        thr_we.next = thr_h.valid
+        thr_cam.next = thr_h.data[tbits - 1]
+        thr_addr.next = thr_h.data[tbits - 1:THR_BITS]
+        thr_data.next = thr_h.data[THR_BITS:0]
+
+    insts += [to_harris_m, to_harris_h]
+    h_flags, flags = ImageStream(1, stereo=True), ImageStream(1, stereo=True)
+    insts.append(harris_stereo(hclk, hrst, h_in, h_flags, k_l_h, k_r_h, thr_we, thr_cam, thr_addr, thr_data,
+                               width=width, height=height, blocks=BLOCKS, nms=nms, share=share))
+    f_dropped = Signal(intbv(0)[16:])
+    insts.append(stream_cdc(hclk, hrst, h_flags, clk, rst, flags, f_dropped, depth=16))
+
+    # ---- feature list, counts -----------------------------------------------------------------------------
+    cb = count_bits(width, height)
+    c_addr = Signal(intbv(0)[addr_bits(BLOCKS):])
+    c_data, tot_l, tot_r = Signal(intbv(0)[cb:]), Signal(intbv(0)[cb:]), Signal(intbv(0)[cb:])
+    insts.append(feature_list(clk, rst, flags, feat, c_addr, c_data, tot_l, tot_r, l_ovf, l_done, width=width,
+                              height=height, blocks=BLOCKS, border=border, max_features=max_features))
+    c_reg = Signal(intbv(0)[16:])
+    top = (1 << 16) - 1
+
+    @always_comb
+    def count_port():
+        # FCOUNT's address is camera << 4 | block; feature_list's 2 * block + camera
+        c_addr.next = concat(fcount.addr[4:0], fcount.addr[4])
+
+    @always_seq(clk.posedge, reset=rst)
+    def count_regs():
+        # the window's latency of 2 clocks (the combinational LUT-RAM read, then two registers)
+        c_reg.next = c_data if c_data <= top else top
+        fcount.data.next = c_reg
+        regs.features_left.next = tot_l if tot_l <= top else top
+        regs.features_right.next = tot_r if tot_r <= top else top
+
+    @always_comb
+    def wiring():
+        ctl.rect_want.next = regs.rect_want
+        ctl.feat_want.next = regs.feat_want
+        ctl.rect_release.next = regs.rect_release
+        ctl.feat_release.next = regs.feat_release
+        regs.avail.next = ctl.avail
+        regs.rect_held.next = ctl.rect_held
+        regs.feat_held.next = ctl.feat_held
+        regs.rect_buf.next = ctl.rect_buf
+        regs.feat_buf.next = ctl.feat_buf
+        regs.dropped_left.next = dropped_l
+        regs.dropped_right.next = dropped_r
+        regs.harris_overflows.next = h_dropped_m + f_dropped
+
+    insts += [count_port, count_regs, wiring]
+    return insts

@@ -1,0 +1,410 @@
+"""cocotb bench of the complete front end: two camera models, the SRAM model, the host driver on AXI4-Lite.
+
+The two cameras (:class:`~eyestereo.sim.lib.camera.CameraModel`, each with its own PCLK: 18 MHz and 17.9 MHz
+by default) play a sequence of stereo frames back to back; the SRAM model checks the part's rules; the
+host driver (cocotbext-axi's master with the bus checker) configures mode, k and the block thresholds,
+starts the system, waits for frames, takes the rectified pair and the feature lists (``rect_want``,
+``feat_want``), reads them through the SRAM window and releases them, frame after frame.
+
+Every rectified pair and every feature list the host reads must equal, bit for bit, the numpy chain
+(:func:`eyestereo.tools.models.stereo_frontend.stereo_frontend`) of one stereo pair of the frames the
+cameras sent (which pair the system captured depends on the independent clocks: the bench finds it among
+the pairs of neighbouring frame indices, and requires the captured frames to move on), and so must the
+per-camera totals (FEATURES) and the per-block counts (FCOUNT) of that frame. The model runs with every
+parameter the top was built with that changes the result (:func:`model_params`: ``nms``, ``border``,
+``max_features``, ``frac`` from the config's ``params``, the block's own defaults for the absent ones), so a
+list cut at ``max_features`` (the trailer's overflow flag) is compared like any other. At the end nothing is
+left over: no dropped frames, no Harris-clock overflows, ``list_overflows`` (OVERFLOWS: the completed frames
+whose list was cut, see :func:`check_list_overflows`) equal to the model's count, the SRAM model saw no
+violation, the bus checker no fault. A frame without features is accepted (a flat scene has none); a
+configuration with ``require_features`` asks for features in every frame read (in one at least with
+``adaptive``: the closed loop may drive a frame to none on its way).
+
+The scene: ``images`` (:func:`stereo_frames`: ``random:S``, ``shift:S``, ``files:LEFT,RIGHT``) or ``pair``:
+``[left.npy, right.npy]``, each an (height, width) uint8 array at the camera size, the Y of every frame of
+that camera (:func:`pair_frames`).
+
+The report gives the frame clocks (FRAME_CLOCKS, the sequencer's measurement), the simulated time of
+each stage (capture, rectification, lists complete, host read-out) and the arbiter's per-master counters.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import inspect
+import time
+
+import cocotb
+import numpy as np
+from cocotb.clock import Clock
+from cocotb.simtime import get_sim_time
+from cocotb.triggers import ClockCycles, Edge, Timer
+
+from eyestereo.sim.lib.axil import AxiLiteHost
+from eyestereo.sim.lib.bench import load_config, write_report
+from eyestereo.sim.lib.camera import CameraModel, camera_frame
+from eyestereo.sim.lib.sram_model import SramModel
+from eyestereo.tools.camera import CameraTiming, frame_schedule
+from eyestereo.tools.host_driver import HostDriver
+from eyestereo.tools.models import stereo_frontend as model
+from eyestereo.tools.models.feature_list import parse_words
+from eyestereo.tools.models.harris_mono import k_code
+from eyestereo.tools.models.sram_arbiter import AddressMap
+from eyestereo.tools.regmap import ARB_WORDS
+from eyestereo.tools.sram import SramPart
+
+
+def stereo_frames(spec: str, n: int, width: int, height: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """``n`` stereo pairs of camera words: ``random:S`` (independent random frames), ``shift:S`` (one
+    random scene, the right camera's view shifted by a disparity, the scene moving a pixel per frame) or
+    ``files:LEFT,RIGHT`` (two image files, every frame: :func:`file_pair`)."""
+    kind, _, arg = spec.partition(":")
+    seed = int(arg or 1) if kind != "files" else 0
+    out = []
+    for i in range(n):
+        if kind == "random":
+            out.append((camera_frame(f"random:{seed + 2 * i}", width, height),
+                        camera_frame(f"random:{seed + 2 * i + 1}", width, height)))
+        elif kind == "shift":
+            big = camera_frame(f"random:{seed}", width + 2 * n + 8, height)
+            out.append((big[:, i + 8:i + 8 + width].copy(), big[:, i + 4:i + 4 + width].copy()))
+        elif kind == "files":  # a stereo pair of image files, resized to the camera size, every frame
+            out.append(out[0] if out else file_pair(arg.split(","), width, height))
+        else:
+            raise ValueError(f"unknown stereo frame spec {spec!r}")
+    return out
+
+
+def file_pair(files, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+    """The camera words of a stereo pair of image files: read by the library's one image-input rule
+    (:func:`eyestereo.tools.io.read_image` grey, :func:`~eyestereo.tools.io.to_grey8` on the pair: a
+    16-bit pair shares one shift), resized to the camera size (``cv2.INTER_AREA``)."""
+    import cv2
+
+    from eyestereo.tools.camera import yuv_frame
+    from eyestereo.tools.io import read_image, to_grey8
+
+    files = [str(f) for f in files]
+    if len(files) != 2:
+        raise ValueError(f"files: a stereo pair is two image files, got {len(files)}: {files}")
+    imgs = to_grey8([read_image(f, grey=True) for f in files], files)
+    return tuple(yuv_frame(cv2.resize(img, (width, height), interpolation=cv2.INTER_AREA)) for img in imgs)
+
+
+def pair_frames(pair, n: int, width: int, height: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """``n`` stereo frames of camera words from the config's ``pair``: [left.npy, right.npy], each an
+    (height, width) uint8 array at the camera size, the Y of every frame of that camera (U = V = 128)."""
+    from eyestereo.tools.camera import yuv_frame
+
+    if not isinstance(pair, (list, tuple)) or len(pair) != 2:
+        raise ValueError(f"pair: [left.npy, right.npy] expected, got {pair!r}")
+    words = []
+    for side, f in zip(("left", "right"), pair):
+        try:
+            a = np.load(f, allow_pickle=False)
+        except (OSError, ValueError) as e:
+            raise ValueError(f"pair: cannot read the {side} array {f}: {e}") from None
+        if a.dtype != np.uint8 or a.shape != (height, width):
+            raise ValueError(f"pair: the {side} array {f} is {a.dtype} {a.shape}; the cameras need uint8 "
+                             f"({height}, {width}) (height, width)")
+        words.append(yuv_frame(a))
+    return [tuple(words)] * n
+
+
+#: The top's parameters that change what the system computes, handed to the model by the bench
+#: (quantizers, the calibration, is handed as ``cal``). The others (share, feature_words, cam_depth, kind,
+#: read_latency, rect_depth) change timing or resources only; ``order`` is the cameras' byte order, which the
+#: camera models send in the default order (YUYV) only.
+MODEL_PARAMS = ("nms", "border", "max_features", "frac")
+
+
+def model_params(params: dict) -> dict:
+    """The keyword arguments of :func:`eyestereo.tools.models.stereo_frontend.stereo_frontend` for a top built
+    with ``params``: each of :data:`MODEL_PARAMS` from ``params``, else the block's own default (read from
+    :func:`eyestereo.hdl.system.stereo_frontend.stereo_frontend`'s signature, so the two cannot drift apart)."""
+    from eyestereo.hdl.system.stereo_frontend import stereo_frontend as top
+
+    sig = inspect.signature(top).parameters
+    return {name: params[name] if name in params else sig[name].default for name in MODEL_PARAMS}
+
+
+def frame_digest(words: np.ndarray) -> str:
+    """A frame's identity for the model cache (identical frames, e.g. a still pair, are modelled once)."""
+    a = np.ascontiguousarray(words, dtype=np.int64)
+    return hashlib.sha1(a.tobytes() + str(a.shape).encode()).hexdigest()
+
+
+def choose_thresholds(cal, frames, k, target: int, mp: dict) -> int:
+    """The smallest power-of-two threshold code giving at most ``target`` features per camera on every
+    frame (computed with the model, before the simulation; ``mp``: :func:`model_params`)."""
+    for e in range(0, 20):
+        code = 1 << e
+        ok = True
+        for left, right in frames[:2]:
+            tot = model.stereo_frontend(cal, left, right, k, [code] * 16, **mp)["list"]["totals"]
+            ok &= int(max(tot)) <= target
+        if ok:
+            return code
+    return (1 << 20) - 1
+
+
+@cocotb.test()
+async def frames_bit_exact(dut):
+    cfg = load_config()
+    from eyestereo.hdl.rectify.poly_unit import calibration_param
+
+    cal = calibration_param(cfg["params"]["quantizers"], None, None)
+    w, h = cal.width, cal.height
+    mp = model_params(cfg["params"])  # what the top was built with, for the model
+    mode = cfg.get("mode", "sequential")
+    n_host = cfg.get("frames", 3)
+    # sequential: each frame lets a few camera frames pass (arming, read-out): enough for every one
+    n_cam = cfg.get("camera_frames", 5 * n_host + 4)
+    amap = AddressMap(w, h, cfg["params"].get("feature_words", 2048))
+    if cfg.get("pair") is not None:
+        if cfg.get("images") is not None:
+            raise ValueError("give the scene as images or as pair, not both")
+        frames = pair_frames(cfg["pair"], n_cam, w, h)
+    else:
+        frames = stereo_frames(cfg.get("images") or "random:1", n_cam, w, h)
+    digests = [(frame_digest(a), frame_digest(b)) for a, b in frames]
+    k = k_code(0.04)
+    thr = cfg["threshold"] if cfg.get("threshold") is not None else \
+        choose_thresholds(cal, frames, k, cfg.get("target", 40), mp)
+
+    # clocks: memory 100 MHz, Harris 50 MHz (or as configured), cameras on their own
+    Clock(dut.clk, 10, unit="ns").start()
+    Clock(dut.hclk, int(round(1e3 / cfg.get("harris_mhz", 50.0) * 1000)), unit="ps").start()
+    for r in ("rst", "hrst", "wrst_l", "wrst_r"):
+        getattr(dut, r).value = 1
+    timing = CameraTiming(width=w, height=h, **cfg.get("timing", dict(h_blank=64, v_sync=1, v_back=1, v_front=1)))
+    cams = []
+    for side, mhz, phase in (("l", cfg.get("cam_l_mhz", 18.0), 40_000), ("r", cfg.get("cam_r_mhz", 17.9), 61_000)):
+        period = 2 * int(round(1e6 / mhz / 2))
+        cams.append(CameraModel(dut, f"cam_{side}", timing, period, max(phase, period // 2)))
+    bus = AxiLiteHost(dut, "bus", dut.clk, dut.rst)
+    bus.pauses(cfg.get("pause", 0.0), cfg.get("seed", 1))
+    await ClockCycles(dut.clk, 6)
+    for r in ("rst", "hrst", "wrst_l", "wrst_r"):
+        getattr(dut, r).value = 0
+    sram = SramModel(dut, dut.clk, SramPart(cfg["params"].get("kind", "nobl"), cfg["params"].get("read_latency", 2)))
+    sram.start()
+    drv = HostDriver(bus)
+    await drv.check_id()
+    assert await drv.geometry() == (w, h)
+    await drv.configure(mode=mode, continuous=bool(cfg.get("continuous", mode == "overlapped")), k_left=k,
+                        k_right=k, thresholds_left=[thr] * 16, thresholds_right=[thr] * 16)
+    assert await drv.read_thresholds("THR_LEFT") == [thr] * 16
+    await ClockCycles(dut.clk, 50)  # the thresholds cross into the Harris clock
+
+    for c, (cam, idx) in enumerate(zip(cams, (0, 1))):
+        await cocotb.start(cam.start_clock())
+        cocotb.start_soon(cam.play(frame_schedule([f[idx] for f in frames], timing)))
+
+    # stage times: the converted top keeps the blocks' signals by name (a probe, not a port)
+    events = []
+
+    async def watch(sig, label):
+        while True:
+            await Edge(sig)
+            events.append((label, int(sig.value), get_sim_time(unit="ns")))
+
+    def probe(*patterns):
+        # MyHDL numbers instances per process and per level (rectifier0, rectifier0_0, ...; the naming differs
+        # with the configuration): try the first few of each form
+        for pattern in patterns:
+            for i in range(4):
+                for j in range(4):
+                    try:
+                        return getattr(dut, pattern.format(i=i, j=j))
+                    except AttributeError:
+                        pass
+        return None
+
+    for patterns, label in ((("rectifier{i}_busy", "rectifier{i}_{j}_busy"), "rect_busy"),
+                            (("frontend_sequencer{i}_list_done", "frontend_sequencer{i}_{j}_list_done"), "list_done"),
+                            (("sram_subsystem{i}_sram_arbiter{j}_ctl_cam_held",
+                              "sram_subsystem{i}_{j}_sram_arbiter{i}_{j}_ctl_cam_held",
+                              "sram_subsystem{i}_0_sram_arbiter{j}_0_ctl_cam_held"), "cam_held")):
+        sig = probe(*patterns)
+        if sig is not None:
+            cocotb.start_soon(watch(sig, label))
+        else:
+            dut._log.warning(f"no probe for {label}: its stage time is left out")
+
+    expected = {}  # (i, j, thresholds) -> model outputs, computed on demand
+    cur = ([thr] * 16, [thr] * 16)  # the thresholds the system runs with
+    adaptive = cfg.get("adaptive")  # target features per block: the host closes the loop (thesis 7.2)
+    if adaptive is not None:
+        from eyestereo.tools.matching.adaptive import SecantController
+
+        ctrls = [SecantController(adaptive, init=thr) for _ in range(2)]
+
+    def model_of(i, j):
+        key = (digests[i][0], digests[j][1], tuple(cur[0]), tuple(cur[1]))
+        if key not in expected:
+            expected[key] = model.stereo_frontend(cal, frames[i][0], frames[j][1], k, (list(cur[0]), list(cur[1])),
+                                                  **mp)
+        return expected[key]
+
+    def find(pred, last, diff=None):
+        hits = [(i, j) for i in range(n_cam) for j in range(max(0, i - 1), min(n_cam, i + 2)) if pred(model_of(i, j))]
+        if not hits and diff is not None:
+            best = min(((diff(model_of(i, j)), (i, j)) for i in range(n_cam) for j in range(n_cam)))
+            raise AssertionError(f"no stereo pair of the frames sent gives what the host read; nearest {best}")
+        assert hits, "no stereo pair of the frames sent gives what the host read"
+        hits = [p for p in hits if p > last] or hits
+        return hits[0]
+
+    if cfg.get("speed_us"):  # a speed measurement only: the system capturing, no comparison
+        await drv.start()
+        if cfg.get("speed_skip_us"):  # past the cameras' first VSYNC and back porch: into the active lines
+            await Timer(int(cfg["speed_skip_us"]), unit="us")
+        t0, w0 = get_sim_time(unit="ns"), time.time()
+        await Timer(int(cfg["speed_us"]), unit="us")
+        wall = time.time() - w0
+        sim_us = (get_sim_time(unit="ns") - t0) / 1e3
+        write_report(cfg, dict(mode=mode, width=w, height=h, speed=True, sim_us=sim_us, wall_s=round(wall, 2),
+                               memory_clocks_per_s=round(sim_us * 100 / wall, 1)))
+        return
+    results, last_rect, last_list = [], (-1, -1), (-1, -1)
+    # a frame: up to two camera frames to the pair held, the rectification, the host's read-out before it
+    # (memory clocks; the camera's frame period in PCLK of 1/18 us, the memory clock 100 MHz)
+    timeout = max(5_000_000, int(6 * timing.frame_pclk * 100 / 17.9) + 40 * w * h)
+    t_start = get_sim_time(unit="ns")
+    wall0 = time.time()
+    if mode == "overlapped":
+        await drv.start()
+    for n in range(n_host):
+        t0 = get_sim_time(unit="ns")
+        if mode == "sequential":
+            await drv.start()
+        await drv.wait_frame(after=n, timeout_clocks=timeout, poll_clocks=200)
+        t_frame = get_sim_time(unit="ns")
+        await drv.set(rect_want=1, feat_want=1)
+        for _ in range(2000):
+            st = await drv.status()
+            if st["rect_held"] and st["feat_held"]:
+                break
+            await bus.wait(50)
+        else:
+            raise AssertionError(f"frame {n}: the host never got the rectified pair and the lists ({st})")
+        await drv.set(rect_want=0, feat_want=0)
+        tot = await drv.read("FEATURES")
+        counts = await drv.feature_counts()
+        rect = np.array(await drv.read_sram_words(amap.rectified(st["rect_buf"]), w * h), np.int64).reshape(h, w)
+        fbase = amap.features(st["feat_buf"])
+        lw, i = [], 0
+        while True:  # the list up to its trailer
+            a, b = await drv.read_sram_words(fbase + i, 2)
+            lw += [a, b]
+            i += 2
+            if a == 0xFFFF or i >= amap.feature_words:
+                break
+        t_read = get_sim_time(unit="ns")
+        dut._log.info(f"frame {n}: started {t0 / 1e6:.3f} ms, done {t_frame / 1e6:.3f} ms, read {t_read / 1e6:.3f} ms "
+                      f"(simulated), wall {time.time() - wall0:.1f} s")
+        await drv.pulse("rect_release", "feat_release")
+        pr = find(lambda m: np.array_equal(m["rect_words"], rect), last_rect,
+                  lambda m: (int(np.sum(m["rect_words"] != rect)), np.argwhere(m["rect_words"] != rect)[:4].tolist()))
+        pl = find(lambda m: m["list_words"] == lw, last_list)
+        lst = parse_words([(d, False, False) for d in lw[:-1]] + [(lw[-1], True, True)])[0]
+        last = dict(rect=rect.tolist(), features=[list(f) for f in lst["features"]])
+        ml = model_of(*pl)["list"]  # the model's list of that pair: equal to what the host read
+        results.append(dict(frame=n, rect_pair=pr, list_pair=pl, features=len(lst["features"]),
+                            overflow=bool(lst["overflow"]), model_totals=[int(v) for v in ml["totals"]],
+                            model_overflow=bool(ml["overflow"]), start_ns=t0, frame_ns=t_frame, read_ns=t_read))
+        last_rect, last_list = pr, pl
+        # the totals and per-block counts belong to the last complete frame: the list's pair, or a later
+        # one in the overlapped mode (the system goes on meanwhile): it must be one of the frames sent
+        def counts_ok(m):
+            c = m["list"]["counts"]
+            return [int(x) for x in c[0]] == counts[0] and [int(x) for x in c[1]] == counts[1] and \
+                int(m["list"]["totals"][0]) == tot & 0xFFFF and int(m["list"]["totals"][1]) == tot >> 16
+        find(counts_ok, (-1, -1))
+        results[-1].update(totals=[tot & 0xFFFF, tot >> 16], thresholds=[list(map(int, c)) for c in cur])
+        if adaptive is not None:  # the next frame's thresholds from this frame's block counts
+            cur = tuple([int(v) for v in c.update(np.array(cnt))] for c, cnt in zip(ctrls, counts))
+            await drv.configure(mode=mode, thresholds_left=cur[0], thresholds_right=cur[1])
+    if mode == "overlapped":
+        await drv.stop()
+    # stop ends continuous operation after the frame in progress: up to a camera frame and its rectification
+    for _ in range(max(1000, timeout // 1000)):
+        if not (await drv.status())["busy"]:
+            break
+        await bus.wait(100 if w * h < 10_000 else 1000)
+    else:
+        raise AssertionError("the system stays busy after stop")
+    st = await drv.status()
+    arb = await drv.arbiter()
+    assert st["dropped_left"] == st["dropped_right"] == 0, st
+    assert st["harris_overflows"] == 0, st
+    ovf = check_list_overflows(st, results, [model_of(i, j)["list"]["overflow"] for i in range(n_cam)
+                                             for j in range(max(0, i - 1), min(n_cam, i + 2))]
+                               if st["frames"] > len(results) and adaptive is None else None)
+    assert sram.error is None, sram.error
+    bus.checker.check()
+    if cfg.get("require_features"):
+        # the configuration asks for features (a frame without any tests little); the closed loop may drive
+        # one frame to none on its way
+        assert all(r["features"] > 0 for r in results) if adaptive is None else \
+            any(r["features"] for r in results), [r["features"] for r in results]
+    write_report(cfg, dict(mode=mode, width=w, height=h, threshold=thr, frames=results, bit_exact=True,
+                           model_params=mp, list_overflows=ovf,
+                           frame_clocks=st["frame_clocks"], frames_done=st["frames"], arb=arb,
+                           arb_words=list(ARB_WORDS), total_ns=get_sim_time(unit="ns") - t_start,
+                           camera_frame_pclk=timing.frame_pclk, axi=bus.checker.counts, last=last,
+                           stages=stage_times(events, [r["start_ns"] for r in results])))
+
+
+def check_list_overflows(st: dict, results: list[dict], candidates: list[bool] | None) -> dict:
+    """Check OVERFLOWS.list_overflows against the model; returns what was checked (for the report).
+
+    What the counter counts (hdl/system/frontend_sequencer.py, register map OVERFLOWS): the frames the system
+    *completed* since reset (feature_list's ``frame_done``, the FRAMES register) whose list was cut
+    (feature_list's ``overflow``: more than ``max_features`` features, or one finding the list FIFO full,
+    which the model never does). The frames the host read are known: their lists were compared with the
+    model's, trailer and overflow flag included. When the system completed more (overlapped, continuous:
+    it goes on while the host reads), the others' pairs are not known: ``candidates``, the model's flag of
+    every stereo pair the bench considers, gives their count when all agree (a still scene), else the
+    counter is only bounded by the read frames' count and that plus the unread frames."""
+    done, got = int(st["frames"]), int(st["list_overflows"])
+    read = sum(1 for r in results if r["overflow"])
+    unread = done - len(results)
+    assert unread >= 0, f"the host read {len(results)} frames, the system completed {done}"
+    if unread == 0:
+        rule, lo, hi = "the frames read", read, read
+    elif candidates and len(set(map(bool, candidates))) == 1:
+        n = read + unread * bool(candidates[0])
+        rule, lo, hi = "the frames read and every candidate pair alike", n, n
+    else:
+        rule, lo, hi = "bounded: the unread frames' pairs are not known", read, read + unread
+    assert lo <= got <= hi, (f"list_overflows {got}: the model's lists of the {done} completed frames give "
+                             f"{lo if lo == hi else f'{lo}..{hi}'} ({rule}; {read} of the {len(results)} read)", st)
+    return dict(counted=got, expected=[lo, hi], rule=rule, frames_done=done, frames_read=len(results))
+
+
+def stage_times(events, starts) -> dict:
+    """Mean stage times (us) from the probes: capture (start to the pair held; sequential), rectification
+    (the rectifier's busy), lists (the rectifier's end to the feature list's frame_done)."""
+    def rises(label, level=1):
+        return [t for n, v, t in events if n == label and v == level]
+
+    rb, rf, ld, ch = rises("rect_busy"), rises("rect_busy", 0), rises("list_done"), rises("cam_held")
+    rect = [f - r for r, f in zip(rb, [x for x in rf if x > rb[0]])] if rb else []
+    lists = []
+    for f in rf:
+        nxt = [t for t in ld if t > f]
+        if nxt:
+            lists.append(nxt[0] - f)
+    capture = []
+    for s0 in starts:
+        nxt = [t for t in ch if t > s0]
+        if nxt:
+            capture.append(nxt[0] - s0)
+
+    def mean(v):
+        return round(sum(v) / len(v) / 1e3, 2) if v else None
+
+    return dict(capture_us=mean(capture), rectify_us=mean(rect), lists_after_rectifier_us=mean(lists),
+                rectified_frames=len(rect), list_done_ns=ld, rect_start_ns=rb)

@@ -1,0 +1,1 @@
+"""Measurements written to docs/: benchmarks, the suite's time, vhdl_diff."""
