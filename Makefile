@@ -80,11 +80,11 @@ ccache:
 	  else echo "note: ccache is missing (Debian: sudo apt-get install ccache); Verilator builds will take longer"; fi; }
 
 vhdl: setup
-	$(PY) -m eyestereo.hdl.convert --out build/vhdl
+	$(PY) -m eyestereo.hdl.flow.convert --out build/vhdl
 
 # MyHDL's Verilog conversion of every block: build/verilog/<entity>.v, compiled by Icarus, signedness-checked.
 verilog: setup
-	$(PY) -m eyestereo.hdl.convert --hdl verilog --out build/verilog
+	$(PY) -m eyestereo.hdl.flow.convert --hdl verilog --out build/verilog
 
 sim: simulator
 	$(PY) -m pytest -m sim -n $(JOBS) --dist worksteal
@@ -100,21 +100,21 @@ test: setup
 
 # make test timed (wall and CPU time, slowest tests) into docs/suite.md; measure on a quiet machine
 test-time: setup
-	$(PY) -m eyestereo.sim.suite_time --out docs/suite.md --jobs $(JOBS)
+	$(PY) -m eyestereo.sim.measure.suite_time --out docs/suite.md --jobs $(JOBS)
 
 demo: setup
-	$(PY) -m eyestereo.sim.demo --out build/demo
+	$(PY) -m eyestereo.sim.apps.demo --out build/demo
 
 # GHDL's netlist of every block's VHDL -> Yosys (Spartan-3E resources) and nextpnr-ecp5 (fmax per clock);
 # the table goes to build/synth/resources.md and into docs/benchmarks.md's synth section. SYNTH_JOBS
 # configurations at once (Yosys and nextpnr run single-threaded; the results do not depend on it).
 SYNTH_JOBS ?= $(JOBS)
 synth: setup
-	$(PY) -m eyestereo.hdl.synth --out build/synth --doc docs/benchmarks.md --jobs $(SYNTH_JOBS)
+	$(PY) -m eyestereo.hdl.flow.synth --out build/synth --doc docs/benchmarks.md --jobs $(SYNTH_JOBS)
 
 # WaveDrom diagrams (docs/wavedrom/*.json) -> docs/img/timing/*.svg and docs/timing.md, offline.
 timing: setup
-	$(PY) -m eyestereo.hdl.timing
+	$(PY) -m eyestereo.hdl.flow.timing
 
 # The register map (tools/regmap.py) -> docs/registers.md and README's register table.
 regs: setup
@@ -129,19 +129,19 @@ report: synth
 SHARED ?= ../shared/data
 
 bench: setup
-	$(PY) -m eyestereo.sim.benchmark --out docs/benchmarks.md
+	$(PY) -m eyestereo.sim.measure.benchmark --out docs/benchmarks.md
 	$(PY) -m eyestereo.tools.reports.harris_report --out docs/harris.md \
 	  --image Tsukuba=tests/data/tsukuba_im3.png --image "chessboard left01=tests/data/chessboard_left01.jpg" \
 	  --image Venus=$(SHARED)/middlebury/venus/im2.png
 	$(PY) -m eyestereo.tools.reports.bench_ffc --out docs/ffc.md
 	$(PY) -m eyestereo.tools.reports.bench_matching --middlebury $(SHARED)/middlebury --out docs/matching.md \
 	  --img docs/img
-	$(PY) -m eyestereo.sim.bench_camera --out docs/camera.md
-	$(PY) -m eyestereo.sim.bench_sram --out docs/sram.md
+	$(PY) -m eyestereo.sim.measure.bench_camera --out docs/camera.md
+	$(PY) -m eyestereo.sim.measure.bench_sram --out docs/sram.md
 	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.tools.reports.rectifier_precision
-	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.sim.bench_warper
-	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.sim.bench_rectifier
-	$(PY) -m eyestereo.sim.bench_harris_stereo --out docs/harris_stereo.md --shared $(SHARED)
+	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.sim.measure.bench_warper
+	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.sim.measure.bench_rectifier
+	$(PY) -m eyestereo.sim.measure.bench_harris_stereo --out docs/harris_stereo.md --shared $(SHARED)
 
 clean:
 	rm -rf build .pytest_cache .hypothesis

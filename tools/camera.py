@@ -1,8 +1,8 @@
 """The camera bus on the Python side: OV6630 timing, YUV 4:2:2 words, and the bus schedule of a frame sequence.
 
 The bus itself (PCLK, VSYNC, HREF, 8-bit data, the byte orders and a timing diagram) is documented once, in
-:mod:`eyestereo.hdl.camera_bus`. This module is pure Python/numpy; the cocotb camera model
-(:mod:`eyestereo.sim.camera`) plays what it builds, and the bit-true models
+:mod:`eyestereo.hdl.interfaces.camera_bus`. This module is pure Python/numpy; the cocotb camera model
+(:mod:`eyestereo.sim.lib.camera`) plays what it builds, and the bit-true models
 (:mod:`eyestereo.tools.models.camera_stream`, :mod:`eyestereo.tools.models.camera_interface`) read the same
 schedule, so the bench and the model see one description of what the camera did.
 

@@ -9,7 +9,7 @@ and windows take an index), every field is reachable by name through :meth:`Host
     async def write(address, data, strb=0xF) -> resp  # one bus write
     async def wait(clocks)                            # let time pass (polling)
 
-``eyestereo.sim.axil.AxiLiteBus`` is that object in the cocotb benches (cocotbext-axi's AxiLiteMaster
+``eyestereo.sim.lib.axil.AxiLiteBus`` is that object in the cocotb benches (cocotbext-axi's AxiLiteMaster
 with the bus checker); :class:`ModelBus` runs the driver on the bank's model; a real host wraps its
 memory-mapped window the same way. A response other than OKAY raises :class:`BusError`.
 

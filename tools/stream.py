@@ -1,6 +1,6 @@
 """Image stream on the Python side: frames <-> beats and a protocol checker (pure Python/numpy).
 
-The protocol itself is documented once, in :mod:`eyestereo.hdl.stream`. Here a *beat* is one valid
+The protocol itself is documented once, in :mod:`eyestereo.hdl.interfaces.stream`. Here a *beat* is one valid
 cycle, a tuple ``(data, eol, eof)``; idle cycles are not beats. The reset token is ``(0, False, True)``.
 """
 

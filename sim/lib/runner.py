@@ -310,7 +310,7 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
     test_log = {} if log_file is None else dict(log_file=str(log_file))
     hdl_drivers = config.get("drivers") == "hdl"
     netlist = config.get("design", "vhdl") == "netlist"
-    from eyestereo.sim import ghdl_ieee
+    from eyestereo.sim.lib import ghdl_ieee
 
     fast_ieee = ghdl_ieee.choice(config.get("ieee")) == "fast"
     if fast_ieee and sim != "ghdl":

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from eyestereo.hdl import synth
+from eyestereo.hdl.flow import synth
 from eyestereo.sim.lib.runner import BUILD, ROOT, run_bench
 from eyestereo.tools.camera import CameraTiming, cut, frame_schedule, yuv_frame
 from eyestereo.tools.models.async_fifo import ClockSpec

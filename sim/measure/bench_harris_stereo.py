@@ -28,7 +28,7 @@ import cv2
 import numpy as np
 from myhdl import Signal, intbv
 
-from eyestereo.hdl import catalog
+from eyestereo.hdl.flow import catalog
 from eyestereo.hdl.flow.catalog import BENCH_TOPS, BlockSpec, _k_port, _thr_ports
 from eyestereo.hdl.harris.cornerness_stereo import cornerness_stereo
 from eyestereo.hdl.harris.harris_stereo import latency, multipliers

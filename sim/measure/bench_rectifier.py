@@ -295,7 +295,7 @@ def figure(path: Path = FIG, pattern: str = "*640x480*at_once*") -> Path | None:
 def resources(reuse: bool = False) -> list[dict]:
     """Yosys xc3se cell counts of GHDL's netlist (make synth's flow); ``reuse``: from an earlier run's
     ``stat.txt`` where there is one."""
-    from eyestereo.hdl import synth
+    from eyestereo.hdl.flow import synth
 
     folder = BUILD.parent / "synth_rectifier"
     out = []

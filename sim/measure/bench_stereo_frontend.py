@@ -593,7 +593,7 @@ DEMO = dict(seconds=232, date="2026-12-01", note="the front end 121 s (two Veril
 
 
 def demo_section() -> list[str]:
-    from eyestereo.sim import demo
+    from eyestereo.sim.apps import demo
 
     w, h = demo.SYSTEM_SIZE
     out = ["## make demo", "",

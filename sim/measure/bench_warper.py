@@ -32,7 +32,7 @@ import time
 from pathlib import Path
 
 import eyestereo.sim.harnesses.warper_harness  # noqa: F401  (registers the bench top)
-from eyestereo.hdl import synth
+from eyestereo.hdl.flow import synth
 from eyestereo.sim.lib.runner import BUILD, ROOT, run_bench, slug
 from eyestereo.tools.rectify import calibrations
 from eyestereo.tools.io import atomic_write_text

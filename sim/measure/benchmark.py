@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from eyestereo.hdl import synth
+from eyestereo.hdl.flow import synth
 from eyestereo.sim.lib.runner import BUILD, ROOT, archived_tree, build_dir_of, run_bench, simulator_versions, slug
 from eyestereo.tools.io import atomic_write_text
 
@@ -207,9 +207,10 @@ BEFORE_COMMIT = "958a558"
 _BEFORE_SCRIPT = """
 import json, sys, time, xml.etree.ElementTree as ET
 from pathlib import Path
-try:
-    from eyestereo.sim.lib.runner import run_bench
-except ModuleNotFoundError:  # a tree before the rooms (issue 22)
+import eyestereo.sim
+if (Path(eyestereo.sim.__path__[0]) / "lib" / "runner.py").exists():  # by its files: the editable install
+    from eyestereo.sim.lib.runner import run_bench                         # would answer a missing import
+else:  # a tree before the rooms (issue 22)
     from eyestereo.sim.runner import run_bench
 case = json.loads(sys.argv[1])
 root = Path(sys.argv[2])

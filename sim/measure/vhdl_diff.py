@@ -50,17 +50,18 @@ _CONVERT = r'''
 import importlib, json, sys
 from pathlib import Path
 label, block, params, out, imports, hdl = json.loads(sys.argv[1])
-def flat(m):  # the module's name before the rooms of issue 22: eyestereo.<hdl|sim>.<room>.<name> -> eyestereo.<hdl|sim>.<name>
+import eyestereo.hdl
+# Which layout is this tree's? Asked of its files, not of an import: the working tree's editable install
+# would answer an import the older tree lacks (eyestereo.hdl.flow) with today's module.
+ROOMS = (Path(eyestereo.hdl.__path__[0]) / "flow" / "convert.py").exists()
+def flat(m):  # before the rooms of issue 22: eyestereo.<hdl|sim>.<room>.<name> -> eyestereo.<hdl|sim>.<name>
     p = m.split(".")
-    return ".".join(p[:2] + p[3:]) if len(p) == 4 else m
+    return ".".join(p[:2] + p[3:]) if len(p) == 4 and p[1] in ("hdl", "sim") else m
 for m in imports:
-    try:
-        importlib.import_module(m)
-    except ModuleNotFoundError:
-        importlib.import_module(flat(m))
-try:
+    importlib.import_module(m if ROOMS else flat(m))
+if ROOMS:
     from eyestereo.hdl.flow.convert import convert
-except ModuleNotFoundError:  # a commit before the rooms
+else:
     from eyestereo.hdl.convert import convert
 def tup(v):
     return tuple(tup(x) for x in v) if isinstance(v, list) else v

@@ -90,7 +90,7 @@ def test_matches_picture_colours_the_known_disparity(tmp_path):
     """The matched-features picture on a pair with a known shift: every corner found again at d = 5."""
     import numpy as np
 
-    from eyestereo.sim.cli_system import _matches_picture
+    from eyestereo.sim.apps.cli_system import _matches_picture
 
     rng = np.random.default_rng(3)
     big = rng.integers(0, 256, (48, 80))

@@ -164,7 +164,7 @@ def test_one_image_rule_for_16_bit_pairs(tmp_path):
     """Before: sim system kept the top 8 of 16 bits (12-bit data became 4-bit), sim harris refused 16-bit,
     sim rectify shifted by the used bits. Now all three read through read_pair: 12-bit data loses its 4 low
     bits, with one shift for both images."""
-    from eyestereo.sim.cli_rectify import read_pair
+    from eyestereo.sim.apps.cli_rectify import read_pair
 
     rng = np.random.default_rng(1)
     left = rng.integers(0, 4096, (20, 30), dtype=np.uint16)
@@ -265,7 +265,7 @@ def test_a_signal_stops_the_simulation_at_once(tmp_path, how):
 
 def test_runs_build_in_a_folder_of_the_users_each_its_own(tmp_path, monkeypatch):
     """Before: builds went to the package's own build/ (read-only in many installs), one folder for every run."""
-    from eyestereo.sim import job
+    from eyestereo.sim.apps import job
 
     monkeypatch.setenv(job.BUILD_ENV, str(tmp_path / "b"))
     with job.run_folder("sim-x") as a, job.run_folder("sim-x") as b:
@@ -279,7 +279,7 @@ def test_runs_build_in_a_folder_of_the_users_each_its_own(tmp_path, monkeypatch)
 
 def test_system_jobs_keep_the_paths_whole(tmp_path):
     """Before: a comma in an image path broke ``sim system`` (the bench took ``files:A,B``)."""
-    from eyestereo.sim.cli_system import run_mode
+    from eyestereo.sim.apps.cli_system import run_mode
 
     target, kwargs, folder = run_mode("sequential", tmp_path, size=(48, 32), frames=1, sim="ghdl")
     assert kwargs["config"]["pair"] == [str(tmp_path / "left.npy"), str(tmp_path / "right.npy")]
@@ -297,7 +297,7 @@ def test_a_bad_build_dir_is_refused_before_the_build(capfd, tmp_path, pair):
 
 def test_a_failed_job_names_a_log_that_exists(tmp_path):
     """Before: messages named temporary folders and logs that were already deleted."""
-    from eyestereo.sim import job
+    from eyestereo.sim.apps import job
 
     with pytest.raises(job.JobFailed) as e, job.run_folder("sim-x", tmp_path) as work:
         job.run_job("eyestereo.tools.fixed:ufix", dict(bits="not a number"), work, what="the test job")

@@ -6,6 +6,8 @@
 * Sub-packages of tools (:data:`ALLOWED`): the core modules (fixed, packed, stream, testpattern, io,
   progress) import no sub-package; models import only the core; rectify the core; matching the core and
   the models; cli everything but the reports; the reports everything.
+* Rooms of hdl and sim (docs/architecture.md): no block imports the EDA flow (``eyestereo.hdl.flow``);
+  a bench (``eyestereo.sim.benches``) imports no other bench.
 * No internals across modules: no module of tools imports a ``_private`` name from another module or
   reaches into one through ``module._name``.
 """
@@ -20,7 +22,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-PACKAGES = {"tools": "eyestereo.tools", "hdl": "eyestereo.hdl"}
+PACKAGES = {"tools": "eyestereo.tools", "hdl": "eyestereo.hdl", "sim": "eyestereo.sim"}
 
 FORBIDDEN = {
     "tools": ("myhdl", "cocotb", "cocotb_tools", "eyestereo.hdl", "eyestereo.sim"),
@@ -90,7 +92,7 @@ def test_checker_finds_forbidden_imports(tmp_path):
         "import myhdl\n"
         "from cocotb.triggers import RisingEdge\n"
         "def f():\n"
-        "    from eyestereo.hdl import stream\n"
+        "    from eyestereo.hdl import harris_mono\n"
         "    import importlib; importlib.import_module('cocotb_tools.runner')\n"
         "from eyestereo import sim\n"
         "from ..sim import bench\n"
@@ -106,9 +108,9 @@ def test_checker_finds_forbidden_imports(tmp_path):
 
 def test_relative_imports_resolve(tmp_path):
     p = tmp_path / "mod.py"
-    p.write_text("from . import window\nfrom .stream import TOKEN\nfrom ..hdl.stream import ImageStream\n")
+    p.write_text("from . import window\nfrom .stream import TOKEN\nfrom ..hdl.interfaces.stream import ImageStream\n")
     mods = {m for _, m in imported_modules(p, "eyestereo.tools")}
-    assert {"eyestereo.tools.window", "eyestereo.tools.stream", "eyestereo.hdl.stream"} <= mods
+    assert {"eyestereo.tools.window", "eyestereo.tools.stream", "eyestereo.hdl.interfaces.stream"} <= mods
 
 
 def test_there_are_modules_to_check():
@@ -129,6 +131,61 @@ def test_tools_module_imports_no_hdl_or_simulator(path):
 @pytest.mark.parametrize("path", py_files("hdl"), ids=lambda p: f"hdl/{p.relative_to(ROOT / 'hdl')}")
 def test_hdl_module_imports_no_sim_or_cocotb(path):
     assert violations("hdl", path) == []
+
+
+# --------------------------------------------------------------------------------------------------
+# Rooms of hdl and sim (docs/architecture.md)
+
+FLOW = "eyestereo.hdl.flow"
+BENCHES = "eyestereo.sim.benches"
+#: bench -> the benches it still borrows helpers from (to move into sim/lib in a later step of issue 22);
+#: the test fails when one of these goes away, so the list shrinks with the code
+KNOWN_BENCH_IMPORTS = {
+    "tb_camera_stream": {"tb_camera_interface"},
+    "tb_coordinate_warper": {"tb_poly_unit"},
+    "tb_fetch_interpolate": {"tb_rectifier"},
+    "tb_harris_cli": {"tb_harris_stereo"},
+}
+
+
+def imports_of(folder: str, path: Path) -> set[str]:
+    mod = module_name(folder, path)
+    package = mod if path.name == "__init__.py" else mod.rsplit(".", 1)[0]
+    return {m for _, m in imported_modules(path, package)}
+
+
+def test_rooms_exist():
+    rooms = {p.parent.name for p in py_files("hdl") if p.parent != ROOT / "hdl"}
+    assert {"interfaces", "common", "streaming", "harris", "rectify", "camera", "memory", "axi", "system",
+            "flow"} <= rooms
+    assert not [p.name for p in (ROOT / "hdl").glob("*.py") if p.name != "__init__.py"]
+    assert not [p.name for p in (ROOT / "sim").glob("*.py") if p.name != "__init__.py"]
+    assert all((p / "__init__.py").exists() for p in [*(ROOT / "hdl").iterdir(), *(ROOT / "sim").iterdir()]
+               if p.is_dir() and p.name != "__pycache__")
+
+
+@pytest.mark.parametrize("path", [p for p in py_files("hdl") if "flow" not in p.relative_to(ROOT / "hdl").parts],
+                         ids=lambda p: f"hdl/{p.relative_to(ROOT / 'hdl')}")
+def test_no_block_imports_the_flow(path):
+    assert not [m for m in imports_of("hdl", path) if is_forbidden(m, (FLOW,))]
+
+
+@pytest.mark.parametrize("path", py_files("sim/benches"), ids=lambda p: f"sim/benches/{p.name}")
+def test_bench_imports_no_other_bench(path):
+    own = path.stem
+    others = {m.split(".")[3] for m in imports_of("sim", path)
+              if m.startswith(BENCHES + ".") and len(m.split(".")) >= 4} - {own}
+    assert others == KNOWN_BENCH_IMPORTS.get(own, set())
+
+
+def test_hdl_reexports_every_catalogue_block():
+    r = subprocess.run([sys.executable, "-c",
+                        "import eyestereo.hdl as H; from eyestereo.hdl.flow.catalog import BLOCKS; "
+                        "fs = {b.func for b in BLOCKS.values()}; "
+                        "missing = sorted(f.__name__ for f in fs if getattr(H, f.__name__, None) is not f); "
+                        "assert not missing, missing; [getattr(H, n) for n in H.__all__]"],
+                       capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert r.returncode == 0, r.stderr
 
 
 # --------------------------------------------------------------------------------------------------
@@ -199,7 +256,7 @@ def private_uses(path: Path, package: str) -> list[str]:
 
 def test_part_checker_and_private_checker_can_fail(tmp_path):
     assert tools_part("eyestereo.tools.models.sobel") == "models" and tools_part("eyestereo.tools.io") == CORE
-    assert tools_part("eyestereo.hdl.sobel") is None
+    assert tools_part("eyestereo.hdl.harris.sobel") is None
     bad = tmp_path / "bad.py"
     bad.write_text("from eyestereo.tools.cli.main import _positive\n"
                    "from eyestereo.tools.rectify import calib as C\n"
@@ -245,6 +302,6 @@ def test_importing_tools_module_loads_no_myhdl_or_cocotb(mod):
 
 
 def test_dynamic_check_can_fail():
-    r = run_check("eyestereo.hdl.stream")  # imports myhdl, so the check must complain
+    r = run_check("eyestereo.hdl.interfaces.stream")  # imports myhdl, so the check must complain
     assert r.returncode != 0
     assert "myhdl" in r.stderr

@@ -159,8 +159,8 @@ def test_model_inputs_that_do_not_fit_are_refused(bank):
 
 
 def _elaborate_bank(**kw):
-    from eyestereo.hdl.catalog import BLOCKS
-    from eyestereo.hdl.register_bank import register_bank
+    from eyestereo.hdl.flow.catalog import BLOCKS
+    from eyestereo.hdl.system.register_bank import register_bank
 
     return register_bank(*BLOCKS["register_bank"].ports()[0].values(), **kw)
 

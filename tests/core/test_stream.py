@@ -1,7 +1,7 @@
 """Unit tests of eyestereo.tools.stream: frames <-> beats, the protocol checker, frame geometry checks.
 
 Expected beat sequences are written out by hand or built by plain loops from the protocol's definition
-in :mod:`eyestereo.hdl.stream`, never by the code under test.
+in :mod:`eyestereo.hdl.interfaces.stream`, never by the code under test.
 """
 
 from __future__ import annotations

@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 from myhdl import ResetSignal, Signal
 
-from eyestereo.hdl.axis import AxiStream
-from eyestereo.hdl.axis_to_stream import axis_to_stream
-from eyestereo.hdl.stream import ImageStream
-from eyestereo.hdl.stream_to_axis import stream_to_axis
-from eyestereo.sim.runner import run_bench
+from eyestereo.hdl.interfaces.axis import AxiStream
+from eyestereo.hdl.axi.axis_to_stream import axis_to_stream
+from eyestereo.hdl.interfaces.stream import ImageStream
+from eyestereo.hdl.axi.stream_to_axis import stream_to_axis
+from eyestereo.sim.lib.runner import run_bench
 from eyestereo.tools.models.axis_to_stream import axis_to_stream as a2s_model
 from eyestereo.tools.models.stream_to_axis import match_frames, split_frames, to_axis
 from eyestereo.tools.stream import TOKEN

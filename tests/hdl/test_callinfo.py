@@ -18,7 +18,7 @@ _SCRIPT = textwrap.dedent("""
     import sys
     from pathlib import Path
     from eyestereo.hdl.common import callinfo
-    from eyestereo.hdl.convert import convert
+    from eyestereo.hdl.flow.convert import convert
     on, out = sys.argv[1] == "1", Path(sys.argv[2])
     (callinfo.install if on else callinfo.uninstall)()
     assert callinfo.installed() == on

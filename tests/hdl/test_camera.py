@@ -13,7 +13,7 @@ import inspect
 import numpy as np
 import pytest
 
-from eyestereo.sim.runner import run_bench
+from eyestereo.sim.lib.runner import run_bench
 from eyestereo.tools.camera import CameraTiming
 from eyestereo.tools.models.async_fifo import ClockSpec
 
@@ -50,8 +50,8 @@ def _run_icarus(block, bench, cfg, name, params):
 
     from cocotb_tools.runner import get_results, get_runner
 
-    from eyestereo.hdl.convert import convert
-    from eyestereo.sim.runner import BUILD, SIM_DIR, slug
+    from eyestereo.hdl.flow.convert import convert
+    from eyestereo.sim.lib.runner import BUILD, SIM_DIR, slug
 
     if shutil.which("iverilog") is None:
         pytest.skip("Icarus Verilog not installed")
@@ -65,7 +65,7 @@ def _run_icarus(block, bench, cfg, name, params):
     env = {"EYESTEREO_TB": json.dumps(dict(cfg, block=block, params=params, report=str(d / "report.json"))),
            "PYTHONPATH": os.pathsep.join([str(SIM_DIR), os.environ.get("PYTHONPATH", "")])}
     n, failed = get_results(runner.test(hdl_toplevel=block, hdl_toplevel_lang="verilog", build_dir=d, test_dir=d,
-                                        test_module=f"eyestereo.sim.{bench}", extra_env=env))
+                                        test_module=f"eyestereo.sim.benches.{bench}", extra_env=env))
     assert n > 0 and failed == 0, f"{failed} of {n} cocotb tests failed on Icarus (see {d})"
     return json.loads((d / "report.json").read_text())
 

@@ -7,14 +7,14 @@ import shutil
 import pytest
 from myhdl import ResetSignal, Signal, intbv
 
-from eyestereo.hdl.async_fifo import async_fifo
-from eyestereo.hdl.camera_bus import CameraBus
-from eyestereo.hdl.camera_interface import camera_interface
-from eyestereo.hdl.camera_stream import camera_stream
-from eyestereo.hdl.catalog import BLOCKS
-from eyestereo.hdl.convert import analyse, convert, vhdl_ports
-from eyestereo.hdl.queue import QueuePort
-from eyestereo.hdl.stream import ImageStream
+from eyestereo.hdl.streaming.async_fifo import async_fifo
+from eyestereo.hdl.interfaces.camera_bus import CameraBus
+from eyestereo.hdl.camera.camera_interface import camera_interface
+from eyestereo.hdl.camera.camera_stream import camera_stream
+from eyestereo.hdl.flow.catalog import BLOCKS
+from eyestereo.hdl.flow.convert import analyse, convert, vhdl_ports
+from eyestereo.hdl.interfaces.queue import QueuePort
+from eyestereo.hdl.interfaces.stream import ImageStream
 
 
 def rst():

@@ -2,7 +2,7 @@
 
 import pytest
 
-from eyestereo.hdl.synth import synth_block
+from eyestereo.hdl.flow.synth import synth_block
 
 pytestmark = pytest.mark.synth
 

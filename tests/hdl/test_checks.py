@@ -6,7 +6,7 @@ from myhdl import ResetSignal, Signal, intbv
 
 from eyestereo.hdl.common.checks import (check_bool, check_choice, check_clock, check_int, check_reset,
                                          check_signal, check_stream)
-from eyestereo.hdl.stream import ImageStream
+from eyestereo.hdl.interfaces.stream import ImageStream
 
 
 @pytest.mark.parametrize("clk", [None, 1, Signal(intbv(0)[2:]), "clk"])

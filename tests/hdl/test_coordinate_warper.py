@@ -1,7 +1,7 @@
-"""GHDL regressions of the coordinate warper against its bit-true model (sim/tb_coordinate_warper.py).
+"""GHDL regressions of the coordinate warper against its bit-true model (sim/benches/tb_coordinate_warper.py).
 
 Each case records every pair the warper hands over (an HDL consumer and recorder around it, see
-sim/warper_harness.py) and compares all of them, with all their fields, with the model: nothing lost,
+sim/harnesses/warper_harness.py) and compares all of them, with all their fields, with the model: nothing lost,
 repeated or reordered. Consumers: at once (combinational and registered pulses), after random delays,
 with long bursts of no acknowledgement; random ``enable``; back-to-back frames; ``start`` while busy;
 ``rst`` in the middle of a frame; run-time coefficients. Small rectified frames of seeded rigs (whose
@@ -10,8 +10,8 @@ maps leave the camera image) for the many cases; one full 352x288 frame of the d
 
 import pytest
 
-import eyestereo.sim.warper_harness  # noqa: F401  (registers the bench top)
-from eyestereo.sim.runner import fastest_simulator, run_bench
+import eyestereo.sim.harnesses.warper_harness  # noqa: F401  (registers the bench top)
+from eyestereo.sim.lib.runner import fastest_simulator, run_bench
 
 pytestmark = pytest.mark.sim
 
@@ -81,7 +81,7 @@ def test_warper_netlist(request):
     Icarus: every pair of two frames, random consumer pulses and random enable."""
     import shutil
 
-    from eyestereo.sim.netlist import run_netlist_bench
+    from eyestereo.sim.lib.netlist import run_netlist_bench
 
     if shutil.which("iverilog") is None:
         pytest.skip("Icarus Verilog not installed")

@@ -2,12 +2,12 @@
 
 Random flag frames and the stereo Harris model's flags, input duty 1.0 .. 0.2, consumer ready 1.0 ..
 0.3, three frames back to back after a partial frame cut by a reset token, a maximum per frame that
-cuts the list (overflow), 1x1 .. 4x4 count blocks. What the bench checks: sim/tb_feature_list.py.
+cuts the list (overflow), 1x1 .. 4x4 count blocks. What the bench checks: sim/benches/tb_feature_list.py.
 """
 
 import pytest
 
-from eyestereo.sim.runner import run_bench
+from eyestereo.sim.lib.runner import run_bench
 
 pytestmark = pytest.mark.sim
 

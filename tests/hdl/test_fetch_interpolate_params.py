@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 from myhdl import ResetSignal, Signal, intbv
 
-from eyestereo.hdl.catalog import BLOCKS
-from eyestereo.hdl.coord_pair import CoordPair
-from eyestereo.hdl.fetch_interpolate import fetch_interpolate
-from eyestereo.hdl.fetch_port import FetchPort
-from eyestereo.hdl.rectifier import rectifier
-from eyestereo.hdl.stream import ImageStream
+from eyestereo.hdl.flow.catalog import BLOCKS
+from eyestereo.hdl.interfaces.coord_pair import CoordPair
+from eyestereo.hdl.rectify.fetch_interpolate import fetch_interpolate
+from eyestereo.hdl.interfaces.fetch_port import FetchPort
+from eyestereo.hdl.rectify.rectifier import rectifier
+from eyestereo.hdl.interfaces.stream import ImageStream
 from eyestereo.tools.models import fetch_interpolate as fi
 from eyestereo.tools.models import poly_unit as unit
 

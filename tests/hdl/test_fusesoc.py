@@ -7,9 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from eyestereo.hdl.catalog import BLOCKS, jsonable
-from eyestereo.hdl.convert import convert
-from eyestereo.hdl.fusesoc import block_core, write_cores
+from eyestereo.hdl.flow.catalog import BLOCKS, jsonable
+from eyestereo.hdl.flow.convert import convert
+from eyestereo.hdl.flow.fusesoc import block_core, write_cores
 
 FUSESOC = Path(sys.executable).parent / "fusesoc"
 needs_fusesoc = pytest.mark.skipif(not FUSESOC.exists() or shutil.which("ghdl") is None,

@@ -1,4 +1,4 @@
-"""The fast numeric_std body for GHDL (eyestereo.sim.ghdl_ieee) computes what IEEE's computes.
+"""The fast numeric_std body for GHDL (eyestereo.sim.lib.ghdl_ieee) computes what IEEE's computes.
 
 One VHDL testbench reads operand pairs (any std_ulogic values, any widths) and writes the results of
 ``+``, ``-`` and ``*`` on UNSIGNED and SIGNED; it runs once against GHDL's standard ieee library and once
@@ -12,7 +12,7 @@ import subprocess
 
 import pytest
 
-from eyestereo.sim import ghdl_ieee
+from eyestereo.sim.lib import ghdl_ieee
 
 needs_ghdl = pytest.mark.skipif(shutil.which("ghdl") is None or not ghdl_ieee.SRC.is_dir(),
                                 reason="GHDL with its IEEE sources needed")

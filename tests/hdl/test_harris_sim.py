@@ -6,7 +6,7 @@ and two frames back to back; see tests/test_sim.py for what the bench checks.
 
 import pytest
 
-from eyestereo.sim.runner import fastest_ghdl_backend, fastest_simulator, run_bench
+from eyestereo.sim.lib.runner import fastest_ghdl_backend, fastest_simulator, run_bench
 from eyestereo.tools.models import harris_mono as hm
 
 pytestmark = pytest.mark.sim
@@ -111,7 +111,7 @@ def test_harris_mono_random_small(request, nms, k):
 
 
 def test_harris_mono_fast_numeric_std(request):
-    """The bench with the VHDL player/recorder on GHDL's faster numeric_std (sim/ghdl_ieee.py, what the
+    """The bench with the VHDL player/recorder on GHDL's faster numeric_std (sim/lib/ghdl_ieee.py, what the
     speed benchmark's fastest GHDL column uses): bit-exact with the model, reset token and idle cycles
     included (tests/hdl/test_ghdl_ieee.py compares the library itself with IEEE's)."""
     rep = _run("harris_mono", "tb_harris_mono", dict(width=48, height=36, blocks=(2, 2), nms=3),

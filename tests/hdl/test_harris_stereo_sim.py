@@ -3,13 +3,13 @@
 Random frame pairs at a small size over every share factor, NMS size and threshold layout, duty cycles
 from full speed (a beat every ``share`` clocks) down to sparse (0.1), two frame pairs back to back after
 a partial pair cut by a reset token (after a left beat), different k and thresholds for the two cameras.
-What the bench checks: sim/tb_harris_stereo.py. Full 352x288 real pairs: sim/bench_harris_stereo.py
+What the bench checks: sim/benches/tb_harris_stereo.py. Full 352x288 real pairs: sim/measure/bench_harris_stereo.py
 (``make bench``), not here (about a minute of GHDL each).
 """
 
 import pytest
 
-from eyestereo.sim.runner import run_bench
+from eyestereo.sim.lib.runner import run_bench
 from eyestereo.tools.models import harris_mono as hm
 
 pytestmark = pytest.mark.sim

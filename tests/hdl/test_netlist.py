@@ -1,6 +1,6 @@
 """The netlist ``make synth`` measures is the VHDL's: GHDL's synthesis, repaired, simulated bit-exact.
 
-GHDL 2.0 writes two constructs of its netlist wrongly in Verilog (see :mod:`eyestereo.hdl.netlist`); the
+GHDL 2.0 writes two constructs of its netlist wrongly in Verilog (see :mod:`eyestereo.hdl.flow.netlist`); the
 unit tests show each repair on GHDL's own output, and the benches run the repaired netlist in Icarus
 Verilog against the bit-true models, with the same stimulus kinds as the VHDL regressions.
 """
@@ -9,7 +9,7 @@ import shutil
 
 import pytest
 
-from eyestereo.hdl.netlist import NetlistError, fix_arithmetic_shifts, lint_vhdl, patch_pmux_defaults, repair, \
+from eyestereo.hdl.flow.netlist import NetlistError, fix_arithmetic_shifts, lint_vhdl, patch_pmux_defaults, repair, \
     vhdl_select_defaults
 from eyestereo.tools.models import harris_mono as hm
 
@@ -90,7 +90,7 @@ def test_lint_refuses_comparisons_ghdl_synthesizes_wrongly(tmp_path):
 
 # --- the repaired netlist in Icarus, bit for bit against the models --------------------------------
 def _run(block, bench, params, stim, request):
-    from eyestereo.sim.netlist import run_netlist_bench
+    from eyestereo.sim.lib.netlist import run_netlist_bench
 
     report = run_netlist_bench(block, bench, stim, name=request.node.name, params=params)
     assert report["frames"] == len(stim["frames"]) and report["pixels_compared"] > 0
@@ -126,7 +126,7 @@ def test_netlist_equals_model(request, block):
 @pytest.mark.sim
 def test_axis_bridges_netlists(request):
     """The AXI4-Stream bridges as synthesized, under back-pressure and with an overflow, on Icarus."""
-    from eyestereo.sim.netlist import run_netlist_bench
+    from eyestereo.sim.lib.netlist import run_netlist_bench
 
     frames = ["random:1", "random:2", "random:3"]
     rep = run_netlist_bench("stream_to_axis", "tb_stream_to_axis",

@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 from myhdl import ResetSignal, Signal, intbv
 
-from eyestereo.hdl.catalog import BLOCKS, get
-from eyestereo.hdl.convolve import convolve
-from eyestereo.hdl.line_delay import line_delay
-from eyestereo.hdl.sobel import sobel
-from eyestereo.hdl.stream import ImageStream
+from eyestereo.hdl.flow.catalog import BLOCKS, get
+from eyestereo.hdl.streaming.convolve import convolve
+from eyestereo.hdl.streaming.line_delay import line_delay
+from eyestereo.hdl.harris.sobel import sobel
+from eyestereo.hdl.interfaces.stream import ImageStream
 
 BINOMIAL3 = np.outer([1, 2, 1], [1, 2, 1])  # sum <= 16 * 255: 8 bits after shift=4, 12 bits with shift=0
 BINOMIAL5 = np.outer([1, 4, 6, 4, 1], [1, 4, 6, 4, 1])  # sum <= 256 * 255: 8 bits after shift=8

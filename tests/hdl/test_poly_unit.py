@@ -1,4 +1,4 @@
-"""GHDL regressions of poly_unit against its bit-true model (cocotb bench sim/tb_poly_unit.py).
+"""GHDL regressions of poly_unit against its bit-true model (cocotb bench sim/benches/tb_poly_unit.py).
 
 Every clock is compared: the output of each input after exactly 8 enabled clocks, the outputs frozen
 while ``enable`` is low, coord (cut to ``frac`` bits) and out_of_range equal to the model built on the
@@ -11,7 +11,7 @@ import zlib
 
 import pytest
 
-from eyestereo.sim.runner import run_bench
+from eyestereo.sim.lib.runner import run_bench
 
 pytestmark = pytest.mark.sim
 
@@ -80,7 +80,7 @@ def test_poly_unit_netlist(request, spec, coefficients):
     """GHDL's netlist of the VHDL (what make synth measures), in Icarus, against the same model."""
     import shutil
 
-    from eyestereo.sim.netlist import run_netlist_bench
+    from eyestereo.sim.lib.netlist import run_netlist_bench
 
     if shutil.which("iverilog") is None:
         pytest.skip("Icarus Verilog not installed")

@@ -7,7 +7,7 @@ counter), small frames.
 
 import pytest
 
-from eyestereo.sim.runner import run_bench
+from eyestereo.sim.lib.runner import run_bench
 
 pytestmark = pytest.mark.sim
 

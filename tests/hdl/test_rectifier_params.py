@@ -4,10 +4,10 @@ names them; the interfaces and the catalogue entries are sized from the calibrat
 import pytest
 from myhdl import ResetSignal, Signal, intbv
 
-from eyestereo.hdl.catalog import BLOCKS
-from eyestereo.hdl.coord_pair import CoordPair
-from eyestereo.hdl.coordinate_warper import coordinate_warper
-from eyestereo.hdl.poly_unit import CoefPort, poly_unit
+from eyestereo.hdl.flow.catalog import BLOCKS
+from eyestereo.hdl.interfaces.coord_pair import CoordPair
+from eyestereo.hdl.rectify.coordinate_warper import coordinate_warper
+from eyestereo.hdl.rectify.poly_unit import CoefPort, poly_unit
 from eyestereo.tools.models import poly_unit as unit
 
 SPEC = "seed:3:2@40x20"

@@ -1,16 +1,16 @@
 """GHDL regressions of fetch_interpolate and the rectifier against their bit-true models.
 
-sim/tb_fetch_interpolate.py drives the block with random-walk coordinate pairs (every case of the reuse
-rule, jumps, black sides, random gaps); sim/tb_rectifier.py runs the whole unit on small rectified frames.
-Both answer the fetch port with the memory model of sim/fetch_memory.py (at once, with random wait
+sim/benches/tb_fetch_interpolate.py drives the block with random-walk coordinate pairs (every case of the reuse
+rule, jumps, black sides, random gaps); sim/benches/tb_rectifier.py runs the whole unit on small rectified frames.
+Both answer the fetch port with the memory model of sim/lib/fetch_memory.py (at once, with random wait
 clocks, a request not taken at once, long stalls), which checks the port's rules; every output beat and
 every request is compared with the model. Full frames (352x288, 640x480) are in the benchmark
-(sim/bench_rectifier.py, make bench).
+(sim/measure/bench_rectifier.py, make bench).
 """
 
 import pytest
 
-from eyestereo.sim.runner import run_bench
+from eyestereo.sim.lib.runner import run_bench
 
 pytestmark = pytest.mark.sim
 
@@ -71,7 +71,7 @@ def test_fetch_interpolate_other_back_ends(request, kind):
     cfg = dict(RANDOM, seed=41, width=16, height=6, frames=2, offer_p=0.7, oor_p=0.15)
     params = dict(quantizers="seed:3:2@40x20", frac=5, depth=3)
     if kind == "netlist":
-        from eyestereo.sim.netlist import run_netlist_bench
+        from eyestereo.sim.lib.netlist import run_netlist_bench
 
         rep = run_netlist_bench("fetch_interpolate", "tb_fetch_interpolate", cfg, name=request.node.name, params=params)
     else:

@@ -4,7 +4,7 @@ import shutil
 
 import pytest
 
-from eyestereo.sim.runner import run_bench
+from eyestereo.sim.lib.runner import run_bench
 
 needs_ghdl = pytest.mark.skipif(shutil.which("ghdl") is None, reason="GHDL not installed")
 
@@ -21,10 +21,10 @@ def test_register_bank_against_table(request):
 # ---- elaboration: ports checked, port list from the table (no simulator needed for these) -----------
 from myhdl import ResetSignal, Signal, intbv  # noqa: E402
 
-from eyestereo.hdl.axil import AxiLite  # noqa: E402
-from eyestereo.hdl.catalog import BLOCKS  # noqa: E402
-from eyestereo.hdl.register_bank import RegisterPorts, register_bank  # noqa: E402
-from eyestereo.hdl.sram_bus import HostPort, StatPort  # noqa: E402
+from eyestereo.hdl.interfaces.axil import AxiLite  # noqa: E402
+from eyestereo.hdl.flow.catalog import BLOCKS  # noqa: E402
+from eyestereo.hdl.system.register_bank import RegisterPorts, register_bank  # noqa: E402
+from eyestereo.hdl.interfaces.sram_bus import HostPort, StatPort  # noqa: E402
 from eyestereo.tools.regmap import REGMAP  # noqa: E402
 
 
@@ -67,7 +67,7 @@ def test_bad_parameters_are_refused(kw, match):
 
 @needs_ghdl
 def test_vhdl_ports_follow_the_table(tmp_path):
-    from eyestereo.hdl.convert import convert, vhdl_ports
+    from eyestereo.hdl.flow.convert import convert, vhdl_ports
 
     files = convert("register_bank", tmp_path)
     ports = {p["name"]: p for p in vhdl_ports(files[-1])}
@@ -90,7 +90,7 @@ def test_vhdl_ports_follow_the_table(tmp_path):
 @pytest.mark.skipif(shutil.which("iverilog") is None, reason="Icarus Verilog not installed")
 def test_register_bank_verilog_on_icarus(request):
     """MyHDL's Verilog back end can differ from its VHDL one: the same bench on the Verilog, in Icarus."""
-    from eyestereo.sim.sram_runner import run_sram_bench
+    from eyestereo.sim.lib.sram_runner import run_sram_bench
 
     rep = run_sram_bench("register_bank", "tb_register_bank", dict(seed=5, pause=0.2, salts=1, full=False, rw_writes=15),
                          name=request.node.name,
@@ -103,7 +103,7 @@ def test_register_bank_verilog_on_icarus(request):
 @pytest.mark.skipif(shutil.which("iverilog") is None, reason="Icarus Verilog not installed")
 def test_register_bank_netlist(request):
     """The netlist make synth measures (GHDL's synthesis of the VHDL) passes the same bench, in Icarus."""
-    from eyestereo.sim.netlist import run_netlist_bench
+    from eyestereo.sim.lib.netlist import run_netlist_bench
 
     rep = run_netlist_bench("register_bank", "tb_register_bank", dict(seed=6, pause=0.2, salts=1, full=False,
                                                                          rw_writes=15), name=request.node.name)
@@ -113,9 +113,9 @@ def test_register_bank_netlist(request):
 @needs_ghdl
 @pytest.mark.sim
 def test_host_driver_on_the_sram_subsystem(request):
-    """The bank wired to the real arbiter and controller (sim/host_harness.py): the host reads a camera
+    """The bank wired to the real arbiter and controller (sim/harnesses/host_harness.py): the host reads a camera
     frame and the arbiter's counters through the bus."""
-    import eyestereo.sim.host_harness  # noqa: F401  (registers the bench top)
+    import eyestereo.sim.harnesses.host_harness  # noqa: F401  (registers the bench top)
 
     rep = run_bench("host_system_tb", "tb_host_system", dict(seed=2, pause=0.2), name=request.node.name,
                     params=dict(width=16, height=4, feature_words=64))

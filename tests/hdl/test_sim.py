@@ -8,7 +8,7 @@ pixel whose window lies inside the image, frame and token counts, and that nothi
 
 import pytest
 
-from eyestereo.sim.runner import run_bench
+from eyestereo.sim.lib.runner import run_bench
 
 pytestmark = pytest.mark.sim
 
@@ -121,7 +121,7 @@ def test_latency_and_throughput(request, block, bench, params, radius, latency, 
     """Latency equals the docstring's, and back-to-back frames come out at one pixel per clock."""
     import numpy as np
 
-    from eyestereo.hdl.catalog import get
+    from eyestereo.hdl.flow.catalog import get
 
     assert doc in " ".join(get(block).func.__doc__.split())
     spec = {"random": "random:{}", "grad": "grad:{}:128", "rwindow": "rwindow:{}", "rcorner": "rcorner:{}:-9:9"}[stim]

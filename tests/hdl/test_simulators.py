@@ -1,7 +1,7 @@
 """One design, three simulators: the VHDL on GHDL and MyHDL's Verilog on Icarus and Verilator agree.
 
 * the runner's simulator choice (SIM, GHDL_BACKEND) and its one-line errors;
-* the signedness check of MyHDL's Verilog (:mod:`eyestereo.hdl.vlint`) on known expressions, and on
+* the signedness check of MyHDL's Verilog (:mod:`eyestereo.hdl.flow.vlint`) on known expressions, and on
   every catalogue block (``make verilog``);
 * small frames of several blocks, harris_mono included, on all three simulators: each run passes its
   bench (bit for bit against the model) and the three give the same output words on *every* pixel,
@@ -20,9 +20,9 @@ import shutil
 import numpy as np
 import pytest
 
-from eyestereo.hdl.vlint import mixed_signedness
-from eyestereo.sim import runner
-from eyestereo.sim.runner import build_dir_of, run_bench, simulator
+from eyestereo.hdl.flow.vlint import mixed_signedness
+from eyestereo.sim.lib import runner
+from eyestereo.sim.lib.runner import build_dir_of, run_bench, simulator
 from eyestereo.tools.models import harris_mono as hm
 
 have_icarus = shutil.which("iverilog") is not None
@@ -91,8 +91,8 @@ def test_mixed_signedness_found(stmt, bad):
 
 def test_make_verilog_every_block(tmp_path):
     """make verilog: every catalogue block converts, compiles on Icarus and mixes no signedness."""
-    from eyestereo.hdl.catalog import BLOCKS
-    from eyestereo.hdl.convert import make_verilog
+    from eyestereo.hdl.flow.catalog import BLOCKS
+    from eyestereo.hdl.flow.convert import make_verilog
 
     if not have_icarus:
         pytest.skip("Icarus Verilog needed")
@@ -178,7 +178,7 @@ def test_small_benches_on_verilog(request, sim, case):
     assert rep["frames"] == len(stim["frames"]) and rep["pixels_compared"] > 0
 
 
-# --- the VHDL player and recorder (drivers="hdl", sim/hdl_drivers.py) ---------------------------------------
+# --- the VHDL player and recorder (drivers="hdl", sim/lib/hdl_drivers.py) ---------------------------------------
 @pytest.mark.sim
 def test_hdl_drivers_same_beats_as_python_drivers(tmp_path):
     """The same bench with the stream driven and recorded by VHDL processes: every beat sent and received

@@ -7,7 +7,7 @@ from what the controller was built for, which the model or the scoreboard must r
 
 import pytest
 
-from eyestereo.sim.sram_runner import run_sram_bench
+from eyestereo.sim.lib.sram_runner import run_sram_bench
 
 pytestmark = pytest.mark.sim
 
@@ -52,7 +52,7 @@ def test_controller_verilog(request, kind, sim):
 
 
 def _failure_text(request, block) -> str:
-    from eyestereo.sim.runner import BUILD, slug
+    from eyestereo.sim.lib.runner import BUILD, slug
 
     return " ".join(p.read_text() for p in (BUILD / block / slug(request.node.name)).glob("*.xml"))
 
@@ -149,8 +149,8 @@ def test_double_buffer_model(request, seed, rate):
 @pytest.mark.parametrize("kind", ["nobl", "pipelined"])
 def test_subsystem_documented_latency(request, kind):
     """On a quiet bus the fetch port's first pixel and a host read take the clocks the docstrings state."""
-    from eyestereo.hdl.fetch_port import __doc__ as fetch_doc
-    from eyestereo.hdl.sram_arbiter import sram_arbiter
+    from eyestereo.hdl.interfaces.fetch_port import __doc__ as fetch_doc
+    from eyestereo.hdl.memory.sram_arbiter import sram_arbiter
 
     doc = " ".join(sram_arbiter.__doc__.split())
     assert "fetch request's first pixel comes 11 clocks after" in doc and "host read's word 7 clocks after" in doc

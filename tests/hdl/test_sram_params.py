@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 from myhdl import ResetSignal, Signal, intbv
 
-from eyestereo.hdl.catalog import BLOCKS
-from eyestereo.hdl.convert import analyse, convert, vhdl_ports
-from eyestereo.hdl.fetch_port import FetchPort
-from eyestereo.hdl.queue import QueuePort
-from eyestereo.hdl.sram_bus import HostPort, SramCmd, SramPins, SramRsp, StatPort
-from eyestereo.hdl.stream import ImageStream
+from eyestereo.hdl.flow.catalog import BLOCKS
+from eyestereo.hdl.flow.convert import analyse, convert, vhdl_ports
+from eyestereo.hdl.interfaces.fetch_port import FetchPort
+from eyestereo.hdl.interfaces.queue import QueuePort
+from eyestereo.hdl.interfaces.sram_bus import HostPort, SramCmd, SramPins, SramRsp, StatPort
+from eyestereo.hdl.interfaces.stream import ImageStream
 
 SRAM_BLOCKS = ["sram_controller", "sram_arbiter", "sram_subsystem", "double_buffer"]
 SMALL = dict(width=16, height=8, feature_words=64)

@@ -1,4 +1,4 @@
-"""sim/steps.py: one printed line per step, the step's own output (child processes too) in its log."""
+"""sim/apps/steps.py: one printed line per step, the step's own output (child processes too) in its log."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from eyestereo.sim.steps import StepFailed, StepRunner
+from eyestereo.sim.apps.steps import StepFailed, StepRunner
 
 
 def test_each_step_prints_one_line_and_logs_the_rest(tmp_path):

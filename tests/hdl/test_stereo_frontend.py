@@ -1,9 +1,9 @@
 """GHDL regression of the complete front end (stereo_frontend) against the numpy chain.
 
-sim/tb_stereo_frontend.py: two camera models with independent clocks (18 and 17.9 MHz), the SRAM model
+sim/benches/tb_stereo_frontend.py: two camera models with independent clocks (18 and 17.9 MHz), the SRAM model
 checking the part, the host driver over AXI4-Lite; every rectified pair and feature list read back is
 compared bit for bit with tools.models.stereo_frontend (camera -> rectifier -> stereo Harris -> feature
-list) on small frames, several consecutive frames, both modes. Full frames: sim/bench_stereo_frontend.py.
+list) on small frames, several consecutive frames, both modes. Full frames: sim/measure/bench_stereo_frontend.py.
 
 test_stereo_frontend_verilator (marker othersims, ``make test-sims``): the same bench on MyHDL's Verilog
 conversion of the top in Verilator, both modes, bit for bit against the same numpy chain.
@@ -20,8 +20,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from eyestereo.sim import runner
-from eyestereo.sim.runner import fastest_simulator, run_bench
+from eyestereo.sim.lib import runner
+from eyestereo.sim.lib.runner import fastest_simulator, run_bench
 from eyestereo.tools.models import stereo_frontend as model
 
 SPEC = "rig:32x24"
@@ -54,8 +54,8 @@ def test_stereo_frontend(request, mode):
 
 def test_model_is_the_chain():
     """The system model is the composition of the block models (spot check on one frame)."""
-    from eyestereo.hdl.poly_unit import calibration_param
-    from eyestereo.sim.camera import camera_frame
+    from eyestereo.hdl.rectify.poly_unit import calibration_param
+    from eyestereo.sim.lib.camera import camera_frame
     from eyestereo.tools.models import harris_stereo, rectifier
 
     cal = calibration_param(SPEC, None, None)
@@ -109,7 +109,7 @@ def real_scene(tmp_path):
 
 def _public():
     """On Verilator, only the signals the bench touches are public (as the measurement script does)."""
-    from eyestereo.sim.bench_stereo_frontend import PUBLIC
+    from eyestereo.sim.measure.bench_stereo_frontend import PUBLIC
 
     return PUBLIC if fastest_simulator() == "verilator" else None
 
@@ -154,8 +154,8 @@ def test_bench_models_with_the_tops_parameters():
     """The bench hands the model what the top was built with, the top's own defaults for the rest."""
     import inspect
 
-    from eyestereo.hdl.stereo_frontend import stereo_frontend as top
-    from eyestereo.sim.tb_stereo_frontend import MODEL_PARAMS, model_params
+    from eyestereo.hdl.system.stereo_frontend import stereo_frontend as top
+    from eyestereo.sim.benches.tb_stereo_frontend import MODEL_PARAMS, model_params
 
     sig = inspect.signature(top).parameters
     assert model_params({}) == {k: sig[k].default for k in MODEL_PARAMS}
@@ -171,7 +171,7 @@ def test_pair_and_files_give_the_same_frames(tmp_path):
     pictures give the same camera words, every frame; a wrong array is refused with its size."""
     import cv2
 
-    from eyestereo.sim.tb_stereo_frontend import pair_frames, stereo_frames
+    from eyestereo.sim.benches.tb_stereo_frontend import pair_frames, stereo_frames
 
     npy = real_scene(tmp_path)
     pngs = []
@@ -198,7 +198,7 @@ def test_pair_and_files_give_the_same_frames(tmp_path):
 def test_list_overflows_rule():
     """What OVERFLOWS.list_overflows is checked against: the read frames' flags; unread completed frames by
     the candidates' flag when they agree, else bounded."""
-    from eyestereo.sim.tb_stereo_frontend import check_list_overflows
+    from eyestereo.sim.benches.tb_stereo_frontend import check_list_overflows
 
     read = [dict(overflow=True), dict(overflow=False)]
     assert check_list_overflows(dict(frames=2, list_overflows=1), read, None)["expected"] == [1, 1]

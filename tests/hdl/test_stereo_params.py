@@ -10,9 +10,9 @@ import re
 import pytest
 from myhdl import Signal, intbv
 
-from eyestereo.hdl.catalog import BLOCKS
-from eyestereo.hdl.queue import QueuePort
-from eyestereo.hdl.stream import ImageStream
+from eyestereo.hdl.flow.catalog import BLOCKS
+from eyestereo.hdl.interfaces.queue import QueuePort
+from eyestereo.hdl.interfaces.stream import ImageStream
 
 
 def _expect(spec, ports, kw, match):

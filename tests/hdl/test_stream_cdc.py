@@ -5,7 +5,7 @@ import shutil
 
 import pytest
 
-from eyestereo.sim.runner import run_bench
+from eyestereo.sim.lib.runner import run_bench
 from eyestereo.tools.models.stream_cdc import pack, unpack
 
 needs_ghdl = pytest.mark.skipif(shutil.which("ghdl") is None, reason="GHDL not installed")
@@ -63,9 +63,9 @@ def test_mono_stream_and_a_token(request):
 # ---- elaboration checks ------------------------------------------------------------------------------
 from myhdl import Signal, intbv  # noqa: E402
 
-from eyestereo.hdl.catalog import BLOCKS  # noqa: E402
-from eyestereo.hdl.stream import ImageStream  # noqa: E402
-from eyestereo.hdl.stream_cdc import stream_cdc  # noqa: E402
+from eyestereo.hdl.flow.catalog import BLOCKS  # noqa: E402
+from eyestereo.hdl.interfaces.stream import ImageStream  # noqa: E402
+from eyestereo.hdl.streaming.stream_cdc import stream_cdc  # noqa: E402
 
 
 @pytest.mark.parametrize("over,kw,match", [

@@ -1,12 +1,12 @@
 """GHDL regressions of the stream checker: every fault class, recovery, repair, mono and stereo.
 
-Each configuration is one simulation of many scenarios (sim/tb_stream_checker.py), compared beat for
+Each configuration is one simulation of many scenarios (sim/benches/tb_stream_checker.py), compared beat for
 beat, cycle for cycle, with the bit-true model.
 """
 
 import pytest
 
-from eyestereo.sim.runner import run_bench
+from eyestereo.sim.lib.runner import run_bench
 
 pytestmark = pytest.mark.sim
 

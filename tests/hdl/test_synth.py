@@ -2,7 +2,7 @@
 
 import pytest
 
-from eyestereo.hdl.synth import parse_fmax, parse_stat, summarize, synth_block, table, write_doc_section
+from eyestereo.hdl.flow.synth import parse_fmax, parse_stat, summarize, synth_block, table, write_doc_section
 
 pytestmark = pytest.mark.synth
 

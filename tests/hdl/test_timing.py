@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from eyestereo.hdl.timing import DOC, JSON_DIR, SVG_DIR, TimingError, ascii_block, build, diagrams, load, render
+from eyestereo.hdl.flow.timing import DOC, JSON_DIR, SVG_DIR, TimingError, ascii_block, build, diagrams, load, render
 
 pytest.importorskip("yowasp_wavedrom")
 
@@ -24,7 +24,7 @@ def test_committed_outputs_are_make_timing_output(tmp_path):
         assert (SVG_DIR / f.name).read_text() == f.read_text(), f"{f.name}: run make timing"
     fresh = files[-1].read_text().replace("(svg/", "(img/timing/")
     assert DOC.read_text() == fresh, "docs/timing.md is not make timing's output: run make timing"
-    assert "```\ncycle   0    1    2" in fresh  # the image stream's ASCII diagram, from hdl/stream.py
+    assert "```\ncycle   0    1    2" in fresh  # the image stream's ASCII diagram, from hdl/interfaces/stream.py
 
 
 def test_broken_diagrams_are_refused(tmp_path):
@@ -43,7 +43,7 @@ def test_broken_diagrams_are_refused(tmp_path):
         with pytest.raises(TimingError):
             load(p)
     d = json.loads(json.dumps(good))
-    d["eyestereo"]["ascii"] = "eyestereo.hdl.stream:NoSuchThing"
+    d["eyestereo"]["ascii"] = "eyestereo.hdl.interfaces.stream:NoSuchThing"
     one = tmp_path / "one"
     one.mkdir()
     (one / "x.json").write_text(json.dumps(d))

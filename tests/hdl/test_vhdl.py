@@ -10,10 +10,10 @@ from pathlib import Path
 import pytest
 from myhdl import ResetSignal, Signal
 
-from eyestereo.hdl.catalog import BLOCKS
-from eyestereo.hdl.convert import GHDL_STDS, analyse, make_vhdl, vhdl_ports
-from eyestereo.hdl.line_delay import line_delay
-from eyestereo.hdl.stream import ImageStream
+from eyestereo.hdl.flow.catalog import BLOCKS
+from eyestereo.hdl.flow.convert import GHDL_STDS, analyse, make_vhdl, vhdl_ports
+from eyestereo.hdl.streaming.line_delay import line_delay
+from eyestereo.hdl.interfaces.stream import ImageStream
 
 needs_ghdl = pytest.mark.skipif(shutil.which("ghdl") is None, reason="GHDL not installed")
 

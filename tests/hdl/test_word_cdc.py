@@ -5,8 +5,8 @@ import shutil
 import pytest
 from myhdl import Signal, intbv
 
-from eyestereo.hdl.word_cdc import word_cdc
-from eyestereo.sim.runner import run_bench
+from eyestereo.hdl.streaming.word_cdc import word_cdc
+from eyestereo.sim.lib.runner import run_bench
 from eyestereo.tools.models.word_cdc import check
 
 

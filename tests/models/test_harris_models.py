@@ -10,7 +10,7 @@ import cv2
 import numpy as np
 import pytest
 
-from eyestereo.sim.bench import make_frame
+from eyestereo.sim.lib.bench import make_frame
 from eyestereo.tools.models import cornerness as cm
 from eyestereo.tools.models import harris_mono as hm
 from eyestereo.tools.models import harris_window as hw

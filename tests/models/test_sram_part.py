@@ -1,7 +1,7 @@
 """The SRAM part model's rules (tools/sram.py) and the controller's cycle-true model, without a simulator.
 
 Each rule is exercised by a hand-written pin sequence that keeps it and one that breaks it; the timing
-model is checked against the timing diagram of hdl/sram_bus.py.
+model is checked against the timing diagram of hdl/interfaces/sram_bus.py.
 """
 
 import re

@@ -66,7 +66,7 @@ def test_system_model_defaults_are_the_tops():
     signature: a bench or a caller leaving one out gets what the hardware builds by default."""
     import inspect
 
-    from eyestereo.hdl.stereo_frontend import stereo_frontend as top
+    from eyestereo.hdl.system.stereo_frontend import stereo_frontend as top
     from eyestereo.tools.models import stereo_frontend as sf
 
     hw = inspect.signature(top).parameters

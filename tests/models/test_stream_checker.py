@@ -192,7 +192,7 @@ def test_fault_table_is_complete():
 
 
 def test_docstring_timing_example():
-    """The timing diagram of hdl/stream_checker.py: a 3x2 frame whose second line is one pixel short."""
+    """The timing diagram of hdl/streaming/stream_checker.py: a 3x2 frame whose second line is one pixel short."""
     beats = [(0, 0, 0), (1, 0, 0), (2, 1, 0), (3, 0, 0), (4, 1, 0), TOKEN, (5, 0, 0), (6, 0, 0)]
     steps = m.stream_checker(beats, 3, 2)
     assert m.fault_positions(steps) == [(4, m.SHORT_LINE)]

@@ -1,6 +1,6 @@
 """docs/suite.md's writer: what it reads from pytest's output, and its refusals (the suite itself is not run)."""
 
-from eyestereo.sim import suite_time
+from eyestereo.sim.measure import suite_time
 
 
 def test_document_lists_the_figures_and_the_slowest_tests():

@@ -15,7 +15,7 @@ are :mod:`eyestereo.tools.cli.common`, the all-or-nothing outputs :mod:`eyestere
 group living there registers itself through the entry-point group ``eyestereo.cli``::
 
     [project.entry-points."eyestereo.cli"]
-    sim = "eyestereo.sim.cli:register"
+    sim = "eyestereo.sim.apps.cli:register"
 
 ``register(subparsers)`` is called like the toolbox's own groups. A group that fails to load does
 not break the other commands: its name becomes a command that reports why in one line.

@@ -1,4 +1,4 @@
-"""Clock-accurate model of :func:`eyestereo.hdl.async_fifo.async_fifo`: which frames come out, which are dropped.
+"""Clock-accurate model of :func:`eyestereo.hdl.streaming.async_fifo.async_fifo`: which frames come out, which are dropped.
 
 The FIFO's behaviour depends on when words arrive, when the reader takes them and when each side sees the
 other's pointer through its two-flop synchroniser. The model knows both clocks (period and phase in ps),

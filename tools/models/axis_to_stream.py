@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.axis_to_stream.axis_to_stream`: AXI4-Stream video -> image stream.
+"""Bit-true model of :func:`eyestereo.hdl.axi.axis_to_stream.axis_to_stream`: AXI4-Stream video -> image stream.
 
 The block counts transfers into ``width`` x ``height`` frames; the model applies the same rules to a list
 of AXI beats ``(tdata, tlast, tuser)`` and returns the image-stream beats ``(data, eol, eof)`` (reset

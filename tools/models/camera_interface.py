@@ -1,7 +1,7 @@
-"""Model of :func:`eyestereo.hdl.camera_interface.camera_interface`: camera bus in, good frames out.
+"""Model of :func:`eyestereo.hdl.camera.camera_interface.camera_interface`: camera bus in, good frames out.
 
-``camera_interface`` is :func:`~eyestereo.hdl.camera_stream.camera_stream` followed by
-:func:`~eyestereo.hdl.async_fifo.async_fifo`; its model is theirs chained: the camera_stream model turns
+``camera_interface`` is :func:`~eyestereo.hdl.camera.camera_stream.camera_stream` followed by
+:func:`~eyestereo.hdl.streaming.async_fifo.async_fifo`; its model is theirs chained: the camera_stream model turns
 the bus schedule into beats (with their PCLK edges), the FIFO model carries them across into the read
 clock with the reader's stall windows and both domains' resets. What comes out is described by a
 :class:`Result`: the beats the reader takes (bit for bit), the complete frames among them with the index

@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.camera_stream.camera_stream`: camera bus schedule -> stream beats.
+"""Bit-true model of :func:`eyestereo.hdl.camera.camera_stream.camera_stream`: camera bus schedule -> stream beats.
 
 The model follows the block's rules sample by sample (runs of blanking are handled at once: they change
 nothing after their first sample):

@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.convolve.convolve`: integer kernels, floor scaling."""
+"""Bit-true model of :func:`eyestereo.hdl.streaming.convolve.convolve`: integer kernels, floor scaling."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.coordinate_warper.coordinate_warper` (thesis 4.2.3).
+"""Bit-true model of :func:`eyestereo.hdl.rectify.coordinate_warper.coordinate_warper` (thesis 4.2.3).
 
 The warper offers one coordinate pair (Pl, Pr) per rectified pixel, in raster order (x fastest), each
 exactly once: the four coordinates of the pixel from the calculation unit

@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.cornerness.cornerness` (thesis 6.2.3).
+"""Bit-true model of :func:`eyestereo.hdl.harris.cornerness.cornerness` (thesis 6.2.3).
 
 c = det(G) - k trace(G)^2 from the window sums, fully pipelined, every multiplier input at most 18 bits
 (two's complement, as the MULT18X18 takes them), no stage able to wrap:

@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.feature_list.feature_list`: corner flags to feature lists and counts.
+"""Bit-true model of :func:`eyestereo.hdl.harris.feature_list.feature_list`: corner flags to feature lists and counts.
 
 The feature words (the interface of the SRAM feature writer, ``sram_arbiter``'s ``feat`` queue port of
 16-bit words, and of the host driver), declared once here:

@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.fetch_interpolate.fetch_interpolate` (thesis 4.3, Figs. 4.9-4.11).
+"""Bit-true model of :func:`eyestereo.hdl.rectify.fetch_interpolate.fetch_interpolate` (thesis 4.3, Figs. 4.9-4.11).
 
 For every coordinate pair (Pl, Pr) of the warper (:mod:`eyestereo.tools.models.coordinate_warper`) the
 block outputs two 8-bit pixels of the stereo stream: the left camera image interpolated at Pl (``cam`` 0),
@@ -36,7 +36,7 @@ __all__ = ["MAX_FRAC", "OFFSETS", "REUSE", "interpolate", "fetch_interpolate", "
 #: Largest ``frac`` the block accepts: weights of 2F+1 <= 17 bits keep both products in an 18x18
 #: multiplier (the Spartan-3E's MULT18X18).
 MAX_FRAC = 8
-#: (ox, oy) of fetch-port index i (hdl/fetch_port.py's order).
+#: (ox, oy) of fetch-port index i (hdl/interfaces/fetch_port.py's order).
 OFFSETS = ((1, 1), (0, 1), (1, 0), (0, 0))
 
 

@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.harris_mono.harris_mono`, the float reference, and helpers.
+"""Bit-true model of :func:`eyestereo.hdl.harris.harris_mono.harris_mono`, the float reference, and helpers.
 
 The chain: Sobel -> harris_window -> cornerness -> prethreshold -> nms, one model per block. The float
 reference :func:`harris_float` uses the same kernels without any quantization and defines the units of

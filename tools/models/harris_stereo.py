@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.harris_stereo.harris_stereo`: the mono model, once per camera.
+"""Bit-true model of :func:`eyestereo.hdl.harris.harris_stereo.harris_stereo`: the mono model, once per camera.
 
 The stereo detector computes, for each camera, exactly what :func:`eyestereo.tools.models.harris_mono.harris_mono`
 computes for that camera's frame with that camera's ``k`` and block thresholds; sharing the line

@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.harris_window.harris_window` (thesis 6.2.2).
+"""Bit-true model of :func:`eyestereo.hdl.harris.harris_window.harris_window` (thesis 6.2.2).
 
 Input: Sobel words (Iy, Ix as sfix[9,-3] codes). The products Ix^2, Iy^2, IxIy are formed per pixel
 from the midpoints of the codes' floor intervals (a code c stands for gradients 8c .. 8c + 7, so the

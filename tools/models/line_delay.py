@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.line_delay.line_delay`."""
+"""Bit-true model of :func:`eyestereo.hdl.streaming.line_delay.line_delay`."""
 
 import numpy as np
 

@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.nms.nms`: non-maximum suppression with a raster tie rule.
+"""Bit-true model of :func:`eyestereo.hdl.harris.nms.nms`: non-maximum suppression with a raster tie rule.
 
 A pixel is a feature when its value is > 0 and it beats every other pixel of the size x size window
 centred on it, where "beats" means: strictly greater than the neighbours that come before it in raster

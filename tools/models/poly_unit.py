@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.poly_unit.poly_unit`, the merged calculation unit (thesis 4.2.1).
+"""Bit-true model of :func:`eyestereo.hdl.rectify.poly_unit.poly_unit`, the merged calculation unit (thesis 4.2.1).
 
 The unit evaluates the four rectification polynomials (``left_x``, ``left_y``, ``right_x``, ``right_y``)
 in the levelized Horner form of the float-to-fixed conversion with its 26 quantizers; the arithmetic is

@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.prethreshold.prethreshold` (thesis 6.2.4)."""
+"""Bit-true model of :func:`eyestereo.hdl.harris.prethreshold.prethreshold` (thesis 6.2.4)."""
 
 from __future__ import annotations
 

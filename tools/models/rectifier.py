@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.rectifier.rectifier`: coordinate warper + fetch and interpolation.
+"""Bit-true model of :func:`eyestereo.hdl.rectify.rectifier.rectifier`: coordinate warper + fetch and interpolation.
 
 One definition of the arithmetic: the coordinates and flags are the coordinate warper's model
 (:func:`eyestereo.tools.models.coordinate_warper.coordinate_warper`, itself the toolbox's fixed-point

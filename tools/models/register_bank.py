@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.register_bank.register_bank`, transaction by transaction.
+"""Bit-true model of :func:`eyestereo.hdl.system.register_bank.register_bank`, transaction by transaction.
 
 The model knows nothing but the register table (:data:`eyestereo.tools.regmap.REGMAP`) and the bus rules
 of docs/registers.md: what every read returns (data and response), what every write changes, which

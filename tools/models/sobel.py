@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.sobel.sobel`: Ix, Iy as sfix[9,-3] (floor of G/8)."""
+"""Bit-true model of :func:`eyestereo.hdl.harris.sobel.sobel`: Ix, Iy as sfix[9,-3] (floor of G/8)."""
 
 import numpy as np
 

@@ -1,10 +1,10 @@
-"""Python side of :func:`eyestereo.hdl.sram_arbiter.sram_arbiter`: the address map, the words it stores, and
+"""Python side of :func:`eyestereo.hdl.memory.sram_arbiter.sram_arbiter`: the address map, the words it stores, and
 the scoreboard models the benches check it with (pure Python/numpy).
 
 * :class:`AddressMap` -- where every frame buffer lives in the 1M words (documented in docs/sram.md).
 * :data:`CAMERA_WORD`, :data:`RECT_WORD` -- the packed words of the camera and rectified buffers.
 * :func:`fetch_addresses` -- the reads a pixel-fetch request turns into.
-* :class:`DoubleBufferModel` -- the buffer states of :func:`eyestereo.hdl.frame_buffers.double_buffer`.
+* :class:`DoubleBufferModel` -- the buffer states of :func:`eyestereo.hdl.memory.frame_buffers.double_buffer`.
 * :class:`Scoreboard` -- every word's expected value, in the order the SRAM sees the accesses.
 """
 
@@ -144,7 +144,7 @@ FREE, WRITING, FULL, READING = range(4)
 
 @dataclass
 class DoubleBufferModel:
-    """Clock-true model of :func:`eyestereo.hdl.frame_buffers.double_buffer`: call :meth:`clock` once per
+    """Clock-true model of :func:`eyestereo.hdl.memory.frame_buffers.double_buffer`: call :meth:`clock` once per
     rising edge with the inputs of the clock that edge ends; the attributes are then the registers.
 
     The rules: a consumer's take (``c_take`` while a FULL buffer exists and none is held) takes the

@@ -1,4 +1,4 @@
-"""Cycle-true model of :func:`eyestereo.hdl.sram_controller.sram_controller`: which clocks it takes a command
+"""Cycle-true model of :func:`eyestereo.hdl.memory.sram_controller.sram_controller`: which clocks it takes a command
 in, and in which clock each read's data comes back (pure Python).
 
 The controller's data behaviour is the part's (a read returns the last word written, see

@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.stereo_frontend.stereo_frontend`: the numpy chain of the whole front end.
+"""Bit-true model of :func:`eyestereo.hdl.system.stereo_frontend.stereo_frontend`: the numpy chain of the whole front end.
 
 camera words (what the camera models send) -> their Y (what the fetch port reads from the camera
 buffers) -> the rectification model (:mod:`eyestereo.tools.models.rectifier`) -> the stereo Harris

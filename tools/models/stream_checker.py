@@ -1,8 +1,8 @@
-"""Bit-true model of :func:`eyestereo.hdl.stream_checker.stream_checker`: the image-stream protocol checker.
+"""Bit-true model of :func:`eyestereo.hdl.streaming.stream_checker.stream_checker`: the image-stream protocol checker.
 
 The checker follows the stream beat by beat with the position (x, y) the next pixel must have (and, for
 stereo streams, which camera's beat is due) and classifies the first beat that breaks the protocol of
-:mod:`eyestereo.hdl.stream` into one of the fault codes below. A *beat* is a tuple ``(data, eol, eof)``
+:mod:`eyestereo.hdl.interfaces.stream` into one of the fault codes below. A *beat* is a tuple ``(data, eol, eof)``
 or ``(data, eol, eof, cam)``; idle cycles are not beats (they change nothing).
 
 Recovery: after a fault the checker no longer knows where it is in the frame. It resumes checking at the

@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.stream_to_axis.stream_to_axis`: frames as AXI4-Stream video beats.
+"""Bit-true model of :func:`eyestereo.hdl.axi.stream_to_axis.stream_to_axis`: frames as AXI4-Stream video beats.
 
 A beat is ``(tdata, tlast, tuser)``: ``tuser`` (SOF) on pixel (0, 0), ``tlast`` (EOL) on the last pixel of
 every line (Xilinx UG934). Without overflow the bridge sends exactly :func:`to_axis` of each frame.

@@ -1,4 +1,4 @@
-"""Model of :func:`eyestereo.hdl.word_cdc.word_cdc`: what ``q`` may show, given what ``d`` was.
+"""Model of :func:`eyestereo.hdl.streaming.word_cdc.word_cdc`: what ``q`` may show, given what ``d`` was.
 
 The block's contract (its docstring): every value ``q`` takes is a value ``d`` had, taken whole, in ``d``'s
 order (so ``q``'s values are a subsequence of ``d``'s); each appears in ``q`` more than two destination

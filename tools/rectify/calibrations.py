@@ -1,6 +1,6 @@
 """Calibrations for the rectification hardware: ``quantizers.json`` documents built by the toolbox, cached.
 
-The calculation unit and the coordinate warper (``hdl/poly_unit.py``, ``hdl/coordinate_warper.py``) are
+The calculation unit and the coordinate warper (``hdl/rectify/poly_unit.py``, ``hdl/rectify/coordinate_warper.py``) are
 elaborated from a ``quantizers.json`` (:func:`eyestereo.tools.rectify.ffc.write_quantizers_json`): the 26
 merged formats and the ten coefficient codes of each polynomial. :func:`load` turns a *calibration spec*
 into such a document (checked by :func:`~eyestereo.tools.rectify.ffc.read_quantizers_json`):
@@ -83,7 +83,7 @@ def shared_data_dir() -> Path:
 
 
 #: The sides a generated calibration may have: the rectifier hardware's frame limit (the fetch port's
-#: 2..4096, the blocks' counters up to 4096: ``hdl/fetch_port.py``, ``hdl/common/checks.py``), checked
+#: 2..4096, the blocks' counters up to 4096: ``hdl/interfaces/fetch_port.py``, ``hdl/common/checks.py``), checked
 #: before anything is built or allocated.
 MIN_SIDE, MAX_SIDE = 2, 4096
 

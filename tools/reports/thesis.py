@@ -21,7 +21,7 @@ framerate       the frame rate: the thesis's 20.01 fps estimate against the syst
                 (``build/system/framerate.json``, written by the complete system's benchmark)
 ==============  =====================================================================================
 
-Resources come from ``build/synth/resources.json`` (:mod:`eyestereo.hdl.synth`; this module reads the
+Resources come from ``build/synth/resources.json`` (:mod:`eyestereo.hdl.flow.synth`; this module reads the
 file and never imports the HDL side). Figures are PNG files in ``--img`` (default: ``img/thesis``
 next to ``--out``); ``make report`` writes ``docs/thesis.md`` and ``docs/img/thesis/``. Progress goes to
 stderr, one line per section. A section that fails is reported in the document and makes the command
