@@ -10,7 +10,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-$(shell (cat pyproject.toml 2>/dev/null || echo none) | cksum | cut -d' ' -f1)
 JOBS   ?= 2
 
-.PHONY: all setup ghdl ccache simulator vhdl verilog sim test test-sims test-time demo synth timing regs report bench clean distclean help
+.PHONY: all setup ghdl ccache simulator vhdl verilog sim test test-sims test-time demo synth timing regs report bench formal clean distclean help
 
 all: test
 
@@ -101,6 +101,12 @@ test: setup
 # make test timed (wall and CPU time, slowest tests) into docs/suite.md; measure on a quiet machine
 test-time: setup
 	$(PY) -m eyestereo.sim.measure.suite_time --out docs/suite.md --jobs $(JOBS)
+
+# SymbiYosys proofs (k-induction) and covers of the property sets in formal/, then their mutants, each of
+# which must be rejected (docs/formal.md); make test runs both too (about 30 s).
+formal: setup
+	$(PY) formal/run.py
+	$(PY) formal/run.py --mutants
 
 demo: setup
 	$(PY) -m eyestereo.sim.apps.demo --out build/demo
