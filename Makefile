@@ -10,7 +10,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-$(shell (cat pyproject.toml 2>/dev/null || echo none) | cksum | cut -d' ' -f1)
 JOBS   ?= 2
 
-.PHONY: all setup ghdl ccache simulator vhdl verilog sim test test-sims test-time demo synth timing regs report bench formal clean distclean help
+.PHONY: all setup ghdl ccache simulator vhdl verilog sim test test-sims test-time demo synth timing regs report bench formal architecture interfaces lint clean distclean help
 
 all: test
 
@@ -95,8 +95,14 @@ test-sims: setup
 
 # --dist worksteal: a worker that runs out of tests takes queued ones from the other (with the default
 # scheduler one core sat idle for the last 7 minutes of a 2-worker run while the other ran the SRAM benches).
-test: setup
+test: setup lint
 	$(PY) -m pytest -n $(JOBS) --dist worksteal --durations=25
+
+# ruff (pycodestyle, pyflakes, bugbear, pyupgrade) and vulture (dead code), configured in pyproject.toml;
+# vulture's known false positives (names only cocotb, MyHDL or pytest call) are listed in .vulture_allow.py
+lint: setup
+	$(VENV)/bin/ruff check hdl sim tools tests formal
+	$(VENV)/bin/vulture
 
 # make test timed (wall and CPU time, slowest tests) into docs/suite.md; measure on a quiet machine
 test-time: setup
@@ -107,6 +113,16 @@ test-time: setup
 formal: setup
 	$(PY) formal/run.py
 	$(PY) formal/run.py --mutants
+
+# Every port bundle's members, directions and widths (each class's MEMBERS) -> docs/interfaces.md;
+# tests/hdl/test_bundles.py checks the page is current.
+interfaces: setup
+	$(PY) -m eyestereo.hdl.flow.ports
+
+# The import graph between the rooms, read from the code -> docs/img/architecture/imports.svg (docs/architecture.md);
+# it also names the arrows the doc's room tables miss. tests/core/test_layering.py checks the picture is current.
+architecture: setup
+	$(PY) -m eyestereo.sim.measure.import_graph
 
 demo: setup
 	$(PY) -m eyestereo.sim.apps.demo --out build/demo

@@ -29,3 +29,17 @@ def tsukuba_pair(tmp_path):
         return tmp_path / "l.png", tmp_path / "r.png"
 
     return make
+
+
+@pytest.fixture
+def cli(capfd):
+    """``cli(*argv)``: the ``eyestereo`` command run in this process on ``argv`` (any objects, turned into
+    strings); returns its exit status and what it wrote to stdout and stderr."""
+    from eyestereo.tools.cli import main
+
+    def run(*argv):
+        code = main.main([str(a) for a in argv])
+        out, err = capfd.readouterr()
+        return code, out, err
+
+    return run

@@ -32,9 +32,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_MAX, FRAME_MIN, FRAME_WIDTH
 from eyestereo.tools.packed import PackedWord
 
-__all__ = ["WORD", "ORDERS", "CameraTiming", "yuv_frame", "line_bytes", "frame_schedule", "cut",
+__all__ = ["WORD", "ORDERS", "CameraTiming", "DEFAULT_TIMING", "yuv_frame", "line_bytes", "frame_schedule", "cut",
            "schedule_length", "vsyncs_before", "Fault"]
 
 #: One camera word per pixel: Y in bits 7..0, the chroma sample (U for even x, V for odd x) in 15..8.
@@ -64,8 +65,8 @@ class CameraTiming:
         vsync_active, href_active: the active level (1 or 0) of VSYNC and HREF.
     """
 
-    width: int = 352
-    height: int = 288
+    width: int = FRAME_WIDTH
+    height: int = FRAME_HEIGHT
     h_blank: int = 192
     v_sync: int = 3
     v_back: int = 19
@@ -80,10 +81,11 @@ class CameraTiming:
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
                 raise ValueError(f"CameraTiming {name} must be an int, got {v!r}")
-        if self.width < 2 or self.width % 2 or self.width > 4096:
-            raise ValueError(f"CameraTiming width={self.width}: must be even and in 2..4096 (pixel pairs)")
-        if not 1 <= self.height <= 4096:
-            raise ValueError(f"CameraTiming height={self.height}: must be in 1..4096")
+        if self.width < FRAME_MIN or self.width % 2 or self.width > FRAME_MAX:
+            raise ValueError(f"CameraTiming width={self.width}: must be even and in {FRAME_MIN}..{FRAME_MAX} "
+                             "(pixel pairs)")
+        if not 1 <= self.height <= FRAME_MAX:
+            raise ValueError(f"CameraTiming height={self.height}: must be in 1..{FRAME_MAX}")
         if self.h_blank < 1:
             raise ValueError(f"CameraTiming h_blank={self.h_blank}: HREF must go inactive between lines (>= 1)")
         if self.v_sync < 1 or self.v_back < 0 or self.v_front < 0:
@@ -119,6 +121,10 @@ class CameraTiming:
     def word_rate(self, pclk_hz: float) -> float:
         """Words per second averaged over a frame."""
         return self.width * self.height * self.fps(pclk_hz)
+
+
+#: The default timing (CIF, the OV6630's): one instance, the default of every function that takes a timing.
+DEFAULT_TIMING = CameraTiming()
 
 
 def yuv_frame(y, u=128, v=128) -> np.ndarray:
@@ -190,7 +196,7 @@ class Fault:
     line_bytes: Mapping[int, int] = field(default_factory=dict)
 
 
-def frame_schedule(frames: Sequence[np.ndarray], timing: CameraTiming = CameraTiming(), *,
+def frame_schedule(frames: Sequence[np.ndarray], timing: CameraTiming = DEFAULT_TIMING, *,
                    faults: Mapping[int, Fault] | None = None) -> list[tuple[str, object]]:
     """The bus schedule of ``frames`` (camera words, each ``height x width``) played back to back."""
     faults = dict(faults or {})

@@ -20,7 +20,9 @@ Reading images (:func:`read_image`) rejects what OpenCV would otherwise decode s
 half-grey pictures: truncated or corrupt PNG (chunk CRCs, the end chunk, the compressed stream) and
 JPEG (the decoder's own "corrupt data" and "premature end" reports), naming the file.
 :func:`to_grey8` states the one rule for pixel depths (16-bit reduced to its 8 most significant used
-bits, floating point refused).
+bits, floating point refused); :func:`centre_crop` cuts a test image to a frame size.
+
+The measurement scripts fill their section of a page in ``docs/`` with :func:`write_section`.
 """
 
 from __future__ import annotations
@@ -47,6 +49,7 @@ __all__ = [
     "atomic_output",
     "atomic_write_bytes",
     "atomic_write_text",
+    "centre_crop",
     "check_image_bytes",
     "check_not_inputs",
     "dir_mode",
@@ -54,6 +57,7 @@ __all__ = [
     "read_image",
     "to_grey8",
     "user_text",
+    "write_section",
 ]
 
 TMP_MARK = ".eyestereo-"  # in every temporary name, so a leftover is recognisable
@@ -219,6 +223,17 @@ def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
             fh.write(text)
 
 
+def write_section(doc: str | os.PathLike[str], text: str, begin: str, end: str) -> None:
+    """Replace what stands between the markers ``begin`` and ``end`` of the page ``doc`` by ``text``
+    (atomically; the markers stay). The measurement scripts fill their part of a page in ``docs/`` so;
+    a page without the section stops them with a SystemExit that names the page and the markers."""
+    old = Path(doc).read_text(encoding="utf-8")
+    pattern = re.compile(re.escape(begin) + r".*?" + re.escape(end), re.S)
+    if not pattern.search(old):
+        raise SystemExit(f"{doc}: no '{begin}' ... '{end}' section to fill")
+    atomic_write_text(doc, pattern.sub(lambda _m: f"{begin}\n{text}{end}", old))
+
+
 def _check_file_target(target: Path) -> None:
     folder = _folder_of(target)
     if not folder.is_dir():
@@ -317,7 +332,7 @@ back as it was. An exception in the block discards every temporary.
 
     def discard(self) -> None:
         """Remove every temporary; the targets stay as they were."""
-        for _, tmp, kind, _ in self._items:
+        for _, tmp, _, _ in self._items:
             _remove(tmp)
             _forget(tmp)
         self._items = []
@@ -663,3 +678,11 @@ def to_grey8(images: np.ndarray | list[np.ndarray], names: str | list[str] = "im
         shift = max(0, top.bit_length() - 8)
         out = [(a >> shift).astype(np.uint8) if a.dtype == np.uint16 else a for a in out]
     return out[0] if single else out
+
+
+def centre_crop(img: np.ndarray, width: int, height: int, name: str = "image") -> np.ndarray:
+    """The ``width`` x ``height`` centre of ``img`` (a view); a ValueError naming ``name`` if it is smaller."""
+    if img.shape[0] < height or img.shape[1] < width:
+        raise ValueError(f"{name} is {img.shape[1]}x{img.shape[0]}, smaller than {width}x{height}")
+    y0, x0 = (img.shape[0] - height) // 2, (img.shape[1] - width) // 2
+    return img[y0:y0 + height, x0:x0 + width]

@@ -26,15 +26,28 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 
 from eyestereo.tools.fixed import Fmt
 
-__all__ = ["Field", "PackedWord"]
+__all__ = ["Field", "PackedWord", "lookup"]
 
 #: Widest word :meth:`PackedWord.pack` handles with int64 arrays (non-negative codes below 2**63).
 MAX_WORD_BITS = 63
+
+T = TypeVar("T")
+
+
+def lookup(table: Mapping[str, T], name: str, what: str, error: type[Exception] = ValueError) -> T:
+    """``table[name]``; a name not in the table raises ``error`` with the message "<what> <name>; it has
+    [<the table's names>]" (``what`` says whose table and of what, e.g. "packed word 'sobel' has no field"),
+    so a misspelt name comes back with the names to choose from."""
+    try:
+        return table[name]
+    except KeyError:
+        raise error(f"{what} {name!r}; it has {list(table)}") from None
 
 
 @dataclass(frozen=True)
@@ -96,10 +109,7 @@ class PackedWord:
         return tuple(f.name for f in self.fields)
 
     def field(self, name: str) -> Field:
-        try:
-            return self._by_name[name]
-        except KeyError:
-            raise ValueError(f"packed word {self.name!r} has no field {name!r}; it has {list(self.names)}") from None
+        return lookup(self._by_name, name, f"packed word {self.name!r} has no field")
 
     def bits(self, name: str) -> tuple[int, int]:
         """(msb + 1, lsb) of a field: the bounds of MyHDL's slice ``word[msb+1:lsb]``."""

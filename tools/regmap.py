@@ -35,9 +35,12 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from eyestereo.tools.constants import FRAME_MAX, FRAME_MIN, K_CODE_DEFAULT
+from eyestereo.tools.packed import lookup
+
 __all__ = ["Field", "Register", "RegisterMap", "REGISTERS", "REGMAP", "KINDS", "OKAY", "SLVERR", "K_BITS",
            "THRESHOLD_BITS", "ARB_WORDS", "RegisterMapError", "RegisterIndexError", "FRAME_MIN", "FRAME_MAX",
-           "check_frame_size", "check_bits"]
+           "FRAME_CONTROL", "check_frame_size", "check_bits"]
 
 #: AXI response codes the bank gives (AXI4-Lite has no EXOKAY; DECERR is not used).
 OKAY, SLVERR = 0, 2
@@ -46,13 +49,16 @@ OKAY, SLVERR = 0, 2
 #: ``tools.models.cornerness.K`` (ufix[8,8]) and ``tools.models.cornerness.OUT`` (the 20-bit threshold code)).
 K_BITS = 8
 THRESHOLD_BITS = 20
-#: k = 0.04 as the k port's code (round(0.04 * 256), ``tools.models.harris_mono.k_code(0.04)``).
-K_RESET = 10
+#: The k registers' reset: k = 0.04 as the k port's code (:data:`eyestereo.tools.constants.K_CODE_DEFAULT`).
+K_RESET = K_CODE_DEFAULT
 
-#: The frame sizes the register bank is built for (its ``width``/``height`` parameters, which GEOMETRY
-#: reports): the rule of :func:`eyestereo.hdl.system.register_bank.register_bank` and of its model, kept here
-#: because tools/ never imports hdl/ (4096 is also ``eyestereo.hdl.common.checks.MAX_SIZE``).
-FRAME_MIN, FRAME_MAX = 2, 4096
+# The frame sizes the register bank is built for (its ``width``/``height`` parameters, which GEOMETRY
+# reports) are eyestereo.tools.constants' FRAME_MIN..FRAME_MAX, re-exported here for the bank's users.
+
+#: The ``connect`` of the fields wired to the SRAM arbiter's FrameControl, followed by the field's name (the
+#: FrameControl member of that name): :func:`eyestereo.hdl.system.frame_handshake.frame_handshake` wires
+#: every field whose ``connect`` says so.
+FRAME_CONTROL = "sram_subsystem ctl_"
 
 #: The SRAM arbiter's status words in its status port's order (names for the host driver; their meaning
 #: is ``STAT`` in eyestereo.tools.models.sram_arbiter, which the test checks this against).
@@ -287,6 +293,11 @@ def _f(name, lsb, width, doc, **kw) -> Field:
     return Field(name, lsb, width, doc, **kw)
 
 
+def _ctl(name, lsb, doc, width=1) -> Field:
+    """A field wired to the arbiter's FrameControl member of the same name."""
+    return Field(name, lsb, width, doc, connect=FRAME_CONTROL + name)
+
+
 REGISTERS: tuple[Register, ...] = (
     Register("ID", 0x000, "const", "identification: 'ES' and the register map's version",
              (_f("id", 0, 32, "0x4553_0001: 'E' 'S', map version 1", reset=0x45530001),)),
@@ -298,31 +309,24 @@ REGISTERS: tuple[Register, ...] = (
                  values=((0, "sequential"), (1, "overlapped")), connect=_SEQ),
               _f("continuous", 1, 1, "0 single-shot (one stereo frame per start), 1 continuous (until stop)",
                  values=((0, "single-shot"), (1, "continuous")), connect=_SEQ),
-              _f("rect_want", 8, 1, "the host takes the newest rectified pair whenever it holds none "
-                 "(FrameControl.rect_want)", connect="sram_subsystem ctl_rect_want"),
-              _f("feat_want", 9, 1, "the same for the feature lists (FrameControl.feat_want)",
-                 connect="sram_subsystem ctl_feat_want"))),
+              _ctl("rect_want", 8, "the host takes the newest rectified pair whenever it holds none "
+                   "(FrameControl.rect_want)"),
+              _ctl("feat_want", 9, "the same for the feature lists (FrameControl.feat_want)"))),
     Register("CMD", 0x00C, "pulse", "commands (write 1 to act; reads 0)",
              (_f("start", 0, 1, "start: one stereo frame (single-shot) or frames until stop (continuous)",
                 connect=_SEQ),
               _f("stop", 1, 1, "stop after the frame in progress", connect=_SEQ),
-              _f("rect_release", 8, 1, "the host has read the rectified pair it holds "
-                 "(FrameControl.rect_release)", connect="sram_subsystem ctl_rect_release"),
-              _f("feat_release", 9, 1, "the host has read the feature lists it holds (FrameControl.feat_release)",
-                 connect="sram_subsystem ctl_feat_release"))),
+              _ctl("rect_release", 8, "the host has read the rectified pair it holds (FrameControl.rect_release)"),
+              _ctl("feat_release", 9, "the host has read the feature lists it holds (FrameControl.feat_release)"))),
     Register("STATUS", 0x010, "status", "state of the system and of the frame buffers",
              (_f("busy", 0, 1, "a start is being served (single-shot: until its frame's lists are written)",
                 connect=_SEQ),
-              _f("avail", 4, 4, "a FULL frame waits in camera 0, camera 1, rectified, features (bits 4..7; "
-                 "FrameControl.avail)", connect="sram_subsystem ctl_avail"),
-              _f("rect_held", 8, 1, "the host holds a rectified pair (FrameControl.rect_held)",
-                 connect="sram_subsystem ctl_rect_held"),
-              _f("feat_held", 9, 1, "the host holds the feature lists (FrameControl.feat_held)",
-                 connect="sram_subsystem ctl_feat_held"),
-              _f("rect_buf", 12, 1, "the rectified buffer held (0/1: its SRAM address, AddressMap.rectified)",
-                 connect="sram_subsystem ctl_rect_buf"),
-              _f("feat_buf", 13, 1, "the feature-list buffer held (AddressMap.features)",
-                 connect="sram_subsystem ctl_feat_buf"))),
+              _ctl("avail", 4, "a FULL frame waits in camera 0, camera 1, rectified, features (bits 4..7; "
+                   "FrameControl.avail)", width=4),
+              _ctl("rect_held", 8, "the host holds a rectified pair (FrameControl.rect_held)"),
+              _ctl("feat_held", 9, "the host holds the feature lists (FrameControl.feat_held)"),
+              _ctl("rect_buf", 12, "the rectified buffer held (0/1: its SRAM address, AddressMap.rectified)"),
+              _ctl("feat_buf", 13, "the feature-list buffer held (AddressMap.features)"))),
     Register("K_LEFT", 0x014, "rw", "Harris k of the left camera, ufix[8,8] (k = code / 256)",
              (_f("k_left", 0, K_BITS, "k code (reset: 10, k = 0.039)", reset=K_RESET,
                  connect="the left Harris k port, through a word_cdc into the Harris clock"),)),
@@ -343,7 +347,8 @@ REGISTERS: tuple[Register, ...] = (
              (_f("harris_overflows", 0, 16, "stereo frames cut crossing into the Harris clock",
                  connect="stream_cdc dropped: the crossing into the Harris clock (back through a word_cdc) plus the "
                          "flags' crossing back"),
-              _f("list_overflows", 16, 16, "completed frames whose feature list was cut at max_features (its trailer's overflow flag)",
+              _f("list_overflows", 16, 16,
+                 "completed frames whose feature list was cut at max_features (its trailer's overflow flag)",
                  connect=_SEQ + " (counts the lists flagged overflowed in ARB words 20, 21)"))),
     Register("FRAME_CLOCKS", 0x030, "status", "memory clocks the last completed frame took from its start "
              "(frames/s = 100e6 / value)", (_f("frame_clocks", 0, 32, "clocks", connect=_SEQ),)),
@@ -422,7 +427,7 @@ class RegisterMap:
             names[r.name] = r
             spans.append((r.offset, r.offset + (r.span if r.kind != "memory" else 4 * r.count), r.name))
         spans.sort()
-        for (a0, a1, n0), (b0, b1, n1) in zip(spans, spans[1:]):
+        for (_, a1, n0), (b0, _, n1) in zip(spans, spans[1:]):
             if b0 < a1:
                 raise RegisterMapError(f"registers {n0} and {n1} overlap")
         object.__setattr__(self, "names", names)
@@ -432,10 +437,7 @@ class RegisterMap:
         return iter(self.registers)
 
     def __getitem__(self, name: str) -> Register:
-        try:
-            return self.names[name]
-        except KeyError:
-            raise KeyError(f"no register {name!r}; registers: {', '.join(self.names)}") from None
+        return lookup(self.names, name, "the register map has no register", KeyError)
 
     def field(self, name: str) -> tuple[Register, Field]:
         """(register, field) of a field name (``"mode"`` or ``"CTRL.mode"``)."""

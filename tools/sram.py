@@ -344,4 +344,5 @@ class SramChip:
 
     def pending(self) -> str:
         return (f"{len(self._reads)} reads, {len(self._writes)} writes in flight (last edge {self._t}; "
-                f"writes of edges {[w.edge for w in self._writes][:4]}, reads of edges {[r.edge for r in self._reads][:4]})")
+                f"writes of edges {[w.edge for w in self._writes][:4]}, "
+                f"reads of edges {[r.edge for r in self._reads][:4]})")

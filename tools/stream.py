@@ -10,6 +10,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from eyestereo.tools.constants import FRAME_MAX
+
 Beat = tuple[int, bool, bool]
 TOKEN: Beat = (0, False, True)
 
@@ -18,7 +20,7 @@ class ProtocolError(Exception):
     """A stream broke the image-stream protocol (wrong line length, eof misplaced, ...)."""
 
 
-def check_geometry(width: int, height: int, *, min_size: int = 1, max_size: int = 4096) -> None:
+def check_geometry(width: int, height: int, *, min_size: int = 1, max_size: int = FRAME_MAX) -> None:
     """Raise ValueError unless width x height is a frame size the blocks can be built for."""
     for name, v in (("width", width), ("height", height)):
         if not isinstance(v, (int, np.integer)) or isinstance(v, bool):

@@ -13,6 +13,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
+
 SUPERSAMPLE = 16
 
 
@@ -22,8 +24,8 @@ class Pattern:
     corners: np.ndarray  # (n, 2) float64, true (x, y) of every shape vertex
 
 
-def corner_pattern(width: int = 352, height: int = 288, *, seed: int = 0, cells=(5, 4), blur: float = 0.0,
-                   rotate: bool = True, contrast: tuple[int, int] = (50, 200)) -> Pattern:
+def corner_pattern(width: int = FRAME_WIDTH, height: int = FRAME_HEIGHT, *, seed: int = 0, cells=(5, 4),
+                   blur: float = 0.0, rotate: bool = True, contrast: tuple[int, int] = (50, 200)) -> Pattern:
     """A pattern of one quadrilateral per grid cell; returns the image and its true corners."""
     if width < 40 or height < 40:
         raise ValueError(f"corner pattern needs at least 40x40 pixels, got {width}x{height}")
@@ -65,7 +67,7 @@ def match_corners(true_xy: np.ndarray, found_xy: np.ndarray) -> tuple[np.ndarray
     return d[np.arange(len(t)), idx], idx
 
 
-def checkerboard_pattern(width: int = 352, height: int = 288, *, seed: int = 0, square: float = 24.0,
+def checkerboard_pattern(width: int = FRAME_WIDTH, height: int = FRAME_HEIGHT, *, seed: int = 0, square: float = 24.0,
                          blur: float = 0.0, rotate: bool = True, contrast: tuple[int, int] = (50, 200),
                          margin: int = 6) -> Pattern:
     """A rotated checkerboard at a random sub-pixel offset; corners are its X-junctions.

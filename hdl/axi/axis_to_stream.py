@@ -2,12 +2,12 @@
 
 from myhdl import Signal, always_comb, always_seq, block, intbv
 
-from eyestereo.hdl.common.checks import check_axis, check_clock, check_distinct, check_int, check_reset, \
-    check_signal, check_stream
+from eyestereo.hdl.axi.bridge_checks import check_bridge
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 
 
 @block
-def axis_to_stream(clk, rst, sink, source, error, *, width: int = 352, height: int = 288):
+def axis_to_stream(clk, rst, sink, source, error, *, width: int = FRAME_WIDTH, height: int = FRAME_HEIGHT):
     """Turn AXI4-Stream video into an image stream of ``width`` x ``height`` frames.
 
     Transfers are counted into lines and frames: ``tuser`` (SOF) starts a frame at pixel (0, 0), ``tlast``
@@ -62,15 +62,8 @@ def axis_to_stream(clk, rst, sink, source, error, *, width: int = 352, height: i
     The SOF in cycle 3 comes after 3 pixels of line 0: the frame is aborted with a token, the SOF
     pixel follows one clock later, and ``tready`` is low for that clock (the next transfer waits).
     """
-    check_clock(clk)
-    check_reset(rst)
-    check_stream("source", source)
-    dw = source.data_width
-    check_axis("sink", sink, data_width=dw)
-    check_signal("error", error, width=1)
-    check_distinct(dict(source=source, error=error), dict(clk=clk, rst=rst, sink=sink))
-    width = check_int("width", width, 1, 4096)
-    height = check_int("height", height, 1, 4096)
+    dw, width, height = check_bridge(clk, rst, ("source", source), ("sink", sink), ("error", error),
+                                     outputs=("source", "error"), width=width, height=height)
 
     x = Signal(intbv(0, min=0, max=width))  # position of the next pixel in the frame in progress
     y = Signal(intbv(0, min=0, max=height))
@@ -109,6 +102,7 @@ def axis_to_stream(clk, rst, sink, source, error, *, width: int = 352, height: i
         error.next = 0
         ready.next = 1
         emit = False
+        abort = False  # a reset token (data 0) and an error pulse end the frame in progress
         if held:
             # Pixel (0, 0) of the frame whose early SOF was answered with a token in the clock before
             # (x and y were set to 0 then).
@@ -118,15 +112,10 @@ def axis_to_stream(clk, rst, sink, source, error, *, width: int = 352, height: i
         elif beat:
             if sink.tuser and in_frame:
                 # Early SOF: abort the frame in progress, keep the SOF pixel for the next clock.
-                source.valid.next = 1
-                source.data.next = 0
-                source.eol.next = 0
-                source.eof.next = 1
-                error.next = 1
+                abort = True
                 held.next = 1
                 held_data.next = pixel
                 ready.next = 0
-                in_frame.next = 0
                 synced.next = 1
                 x.next = 0
                 y.next = 0
@@ -135,12 +124,7 @@ def axis_to_stream(clk, rst, sink, source, error, *, width: int = 352, height: i
                     synced.next = 1
                 if sink.tlast != at_end:
                     # The line ends early or late: abort the frame, wait for the next SOF.
-                    source.valid.next = 1
-                    source.data.next = 0
-                    source.eol.next = 0
-                    source.eof.next = 1
-                    error.next = 1
-                    in_frame.next = 0
+                    abort = True
                     synced.next = 0
                 else:
                     source.data.next = pixel
@@ -149,6 +133,13 @@ def axis_to_stream(clk, rst, sink, source, error, *, width: int = 352, height: i
                 # A transfer between frames: the frame before had too many lines. Drop until an SOF.
                 error.next = 1
                 synced.next = 0
+        if abort:
+            source.valid.next = 1
+            source.data.next = 0
+            source.eol.next = 0
+            source.eof.next = 1
+            error.next = 1
+            in_frame.next = 0
         if emit:
             source.valid.next = 1
             source.eol.next = at_end

@@ -2,15 +2,15 @@
 
 from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv, modbv
 
-from eyestereo.hdl.interfaces.axis import tdata_width
-from eyestereo.hdl.common.checks import check_axis, check_choice, check_clock, check_distinct, check_int, \
-    check_reset, check_signal, check_stream
+from eyestereo.hdl.axi.bridge_checks import check_bridge
+from eyestereo.hdl.common.checks import check_choice, check_int
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 
 COMMITS = ("line", "frame")
 
 
 @block
-def stream_to_axis(clk, rst, sink, source, overflow, *, width: int = 352, height: int = 288,
+def stream_to_axis(clk, rst, sink, source, overflow, *, width: int = FRAME_WIDTH, height: int = FRAME_HEIGHT,
                    depth: int = 1024, commit: str = "line"):
     """Send an image stream out as AXI4-Stream video, honouring ``tready`` through a FIFO.
 
@@ -52,7 +52,8 @@ def stream_to_axis(clk, rst, sink, source, overflow, *, width: int = 352, height
     Resources: ``depth x (data_width + 2)`` bits of block RAM (one RAMB16 for 1024 x 18), three
     pointers, a two-word output stage; no multipliers.
 
-    Handshakes: the image stream's (``hdl/interfaces/stream.py``) in, AXI4-Stream video (``hdl/interfaces/axis.py``) out.
+    Handshakes: the image stream's (``hdl/interfaces/stream.py``) in, AXI4-Stream video
+    (``hdl/interfaces/axis.py``) out.
     Overflow of 4-pixel lines with ``depth = 4``, ``tready`` held low (``words``: words in the FIFO; the
     WaveDrom form is ``docs/wavedrom/stream_to_axis_overflow.json``)::
 
@@ -68,15 +69,8 @@ def stream_to_axis(clk, rst, sink, source, overflow, *, width: int = 352, height
     pulses and (0,1), (1,1), ... up to the frame's end are dropped; line 0 is offered from cycle 6 and
     waits for ``tready``.
     """
-    check_clock(clk)
-    check_reset(rst)
-    check_stream("sink", sink)
-    dw = sink.data_width
-    check_axis("source", source, data_width=dw)
-    check_signal("overflow", overflow, width=1)
-    check_distinct(dict(source=source, overflow=overflow), dict(clk=clk, rst=rst, sink=sink))
-    width = check_int("width", width, 1, 4096)
-    height = check_int("height", height, 1, 4096)
+    dw, width, height = check_bridge(clk, rst, ("sink", sink), ("source", source), ("overflow", overflow),
+                                     outputs=("source", "overflow"), width=width, height=height)
     depth = check_int("depth", depth, 4, 1 << 16)
     if depth & (depth - 1):
         raise ValueError(f"parameter depth={depth} must be a power of two")
@@ -88,7 +82,6 @@ def stream_to_axis(clk, rst, sink, source, overflow, *, width: int = 352, height
 
     aw = depth.bit_length() - 1  # address bits; the pointers carry one more (wrap) bit
     ww = dw + 2  # FIFO word: SOF, EOL, pixel
-    tw = tdata_width(dw)
     mem = [Signal(intbv(0)[ww:]) for _ in range(depth)]
 
     # Write side.

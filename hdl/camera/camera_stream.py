@@ -4,6 +4,7 @@ from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv
 
 from eyestereo.hdl.interfaces.camera_bus import CameraBus
 from eyestereo.hdl.common.checks import block_error, check_choice, check_int, check_reset, check_stream
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_MAX, FRAME_MIN, FRAME_WIDTH
 from eyestereo.tools.camera import ORDERS, WORD
 from eyestereo.tools.models.camera_stream import POSITIONS
 
@@ -19,10 +20,10 @@ def check_camera(name: str, cam, data_width: int = 8) -> None:
 
 def check_camera_params(width, height, order, vsync_active, href_active) -> tuple:
     """The camera parameters checked (for camera_stream and the blocks that wrap it), as plain values."""
-    width = check_int("width", width, 2, 4096)
+    width = check_int("width", width, FRAME_MIN, FRAME_MAX)
     if width % 2:
         raise block_error(f"parameter width={width} must be even: YUV 4:2:2 pixels come in pairs")
-    height = check_int("height", height, 1, 4096)
+    height = check_int("height", height, 1, FRAME_MAX)
     order = check_choice("order", order, ORDERS)
     vsync_active = check_choice("vsync_active", vsync_active, (0, 1))
     href_active = check_choice("href_active", href_active, (0, 1))
@@ -30,8 +31,8 @@ def check_camera_params(width, height, order, vsync_active, href_active) -> tupl
 
 
 @block
-def camera_stream(cam, rst, source, luma=None, *, width: int = 352, height: int = 288, order: str = "YUYV",
-                  vsync_active: int = 1, href_active: int = 1):
+def camera_stream(cam, rst, source, luma=None, *, width: int = FRAME_WIDTH, height: int = FRAME_HEIGHT,
+                  order: str = "YUYV", vsync_active: int = 1, href_active: int = 1):
     """Receive a camera's 8-bit YUV 4:2:2 bus and emit one 16-bit word per pixel as an image stream.
 
     Runs in the camera's clock domain (``cam.pclk``). Every input is registered once at the rising edge
@@ -123,66 +124,68 @@ def camera_stream(cam, rst, source, luma=None, *, width: int = 352, height: int 
     def byte_phase():
         phase.next = n[2:]
 
+    # The frame in progress breaks: a VSYNC before its last line, a byte beyond the line's 2 * width, or
+    # HREF dropped before it.
+    abort = Signal(bool(0))
+
+    @always_comb
+    def check():
+        abort.next = False
+        if armed:
+            if vs_r:
+                abort.next = y != 0 or n != 0
+            elif hr_r:
+                abort.next = n == W2
+            else:
+                abort.next = n != 0 and n != W2
+
     @always_seq(pclk.posedge, reset=rst)
     def fsm():
         o_valid.next = False
         o_eol.next = False
         o_eof.next = False
+        if abort and started:
+            # the reset token: words of the broken frame have come out
+            o_valid.next = True
+            o_eof.next = True
         if vs_r:
-            if armed and (y != 0 or n != 0):
-                # VSYNC before the frame's last line: abort it
-                if started:
-                    o_valid.next = True
-                    o_eof.next = True
             armed.next = True
             started.next = False
             y.next = 0
             n.next = 0
+        elif abort:
+            armed.next = False
+            started.next = False
+            n.next = 0
         elif hr_r:
             if armed:
-                if n == W2:
-                    # a byte beyond the line's 2 * width: abort the frame
-                    if started:
+                if phase == 0:
+                    b0.next = d_r
+                    if n != 0:
                         o_valid.next = True
-                        o_eof.next = True
-                    armed.next = False
-                    started.next = False
-                    n.next = 0
+                        o_data.next = pend
+                elif phase == 1:
+                    b1.next = d_r
+                elif phase == 2:
+                    b2.next = d_r
                 else:
-                    if phase == 0:
-                        b0.next = d_r
-                        if n != 0:
-                            o_valid.next = True
-                            o_data.next = pend
-                    elif phase == 1:
-                        b1.next = d_r
-                    elif phase == 2:
-                        b2.next = d_r
-                    else:
-                        o_valid.next = True
-                        o_data.next = concat(us, y0s)
-                        pend.next = concat(vs_, y1s)
-                        started.next = True
-                    n.next = n + 1
-        elif armed and n != 0:
-            if n == W2:
-                o_valid.next = True
-                o_eol.next = True
-                o_data.next = pend
-                if y == LAST:
-                    o_eof.next = True
-                    armed.next = False
-                    started.next = False
-                    y.next = 0
-                else:
-                    y.next = y + 1
-            else:
-                # HREF dropped early: abort the frame
-                if started:
                     o_valid.next = True
-                    o_eof.next = True
+                    o_data.next = concat(us, y0s)
+                    pend.next = concat(vs_, y1s)
+                    started.next = True
+                n.next = n + 1
+        elif armed and n != 0:
+            # HREF dropped after the line's last byte (n == W2: any other count aborts)
+            o_valid.next = True
+            o_eol.next = True
+            o_data.next = pend
+            if y == LAST:
+                o_eof.next = True
                 armed.next = False
                 started.next = False
+                y.next = 0
+            else:
+                y.next = y + 1
             n.next = 0
 
     @always_comb
@@ -192,7 +195,7 @@ def camera_stream(cam, rst, source, luma=None, *, width: int = 352, height: int 
         source.eol.next = o_eol
         source.eof.next = o_eof
 
-    insts = [inputs, byte_phase, fsm, out]
+    insts = [inputs, byte_phase, check, fsm, out]
     if luma is not None:
         @always_comb
         def luma_out():

@@ -35,13 +35,15 @@ from myhdl import ResetSignal, intbv
 from myhdl._Signal import _Signal
 
 from eyestereo.hdl.interfaces.axis import AxiStream
+from eyestereo.hdl.interfaces.bundle import Bundle
 from eyestereo.hdl.interfaces.stream import ImageStream
+from eyestereo.tools.constants import FRAME_MAX
 
 __all__ = ["check_axis", "check_clock", "check_reset", "check_stream", "check_signal", "check_int", "check_choice",
-           "check_bool", "check_frame", "check_distinct", "block_error", "checked"]
+           "check_bool", "check_frame", "check_distinct", "check_port", "block_error", "checked"]
 
 #: The largest frame side the blocks' counters are sized for.
-MAX_SIZE = 4096
+MAX_SIZE = FRAME_MAX
 
 
 def _block_name() -> str | None:
@@ -100,7 +102,7 @@ def _what(x) -> str:
             article = "an" if str(n).startswith("8") or n in (11, 18) else "a"
             return f"{article} {n}-bit {kind} Signal(intbv)"
         return f"a Signal of {type(v).__name__} {v!r}"[:80]
-    if isinstance(x, (ImageStream, AxiStream)):
+    if isinstance(x, Bundle):
         return repr(x)
     return f"{type(x).__name__} {x!r}"[:80]
 
@@ -131,8 +133,8 @@ def check_reset(rst, name: str = "rst") -> None:
 def check_signal(name: str, sig, *, width: int | None = None, signed: bool | None = None) -> None:
     """A control port: ``Signal(bool)`` or a ``Signal(intbv)`` of ``width`` bits (1 bit: either kind),
     optionally of a signedness."""
-    if isinstance(sig, ImageStream):
-        raise _fail(f"port {name} must be a MyHDL Signal, got an ImageStream (ports out of order?)")
+    if isinstance(sig, Bundle):
+        raise _fail(f"port {name} must be a MyHDL Signal, got {_article(type(sig).__name__)} (ports out of order?)")
     if not isinstance(sig, _Signal):
         raise _fail(f"port {name} must be a MyHDL Signal, got {_what(sig)}")
     if not isinstance(sig.val, (bool, intbv)):
@@ -148,24 +150,35 @@ def check_signal(name: str, sig, *, width: int | None = None, signed: bool | Non
             raise _fail(f"port {name} must be {'signed' if signed else 'unsigned'}, got {_what(sig)}")
 
 
+def _article(word: str) -> str:
+    return f"{'an' if word[0] in 'AEIOU' else 'a'} {word}"
+
+
+def check_port(name: str, port, cls: type) -> None:
+    """A port of the bundle class ``cls`` whose every declared member is a Signal of its declared kind
+    and width (``bool``: a Signal(bool); bits: a Signal(intbv) of that many bits), else a ValueError that
+    names the port, the member and, when the port is not a ``cls`` at all, the members ``cls`` declares."""
+    kind = cls.__name__
+    if not isinstance(port, cls):
+        raise _fail(f"port {name} must be {_article(kind)}, got {_what(port)} ({kind} members: {cls.member_list()})")
+    for m in port.members():
+        sig = getattr(port, m.name, None)
+        if not isinstance(sig, _Signal):
+            raise _fail(f"port {name}: field {m.name} of the {kind} is {_what(sig)}, not a Signal")
+        if m.width is bool:
+            if not isinstance(sig.val, bool):
+                raise _fail(f"port {name}: field {m.name} must be a Signal(bool), got {_what(sig)}")
+        elif not isinstance(sig.val, intbv) or len(sig) != m.bits(port):
+            raise _fail(f"port {name}: its {m.name} field is {_what(sig)}, the {kind} says {m.bits(port)} bits")
+
+
 def check_stream(name: str, stream, *, width: int | None = None, stereo: bool | None = False) -> None:
     """An :class:`~eyestereo.hdl.interfaces.stream.ImageStream` port of ``width`` data bits.
 
     ``stereo``: False (default) = mono only, a stereo stream is refused; True = must be stereo;
     None = either kind (blocks that forward ``cam``; check the source with ``stereo=sink.stereo``).
     """
-    if not isinstance(stream, ImageStream):
-        raise _fail(f"port {name} must be an ImageStream, got {_what(stream)}")
-    for f in stream.fields():
-        sig = getattr(stream, f, None)
-        if not isinstance(sig, _Signal):
-            raise _fail(f"port {name}: field {f} of the ImageStream is {_what(sig)}, not a Signal")
-    if not isinstance(stream.data.val, intbv) or len(stream.data) != stream.data_width:
-        raise _fail(f"port {name}: its data field is {_what(stream.data)}, the stream says "
-                    f"{stream.data_width} bits")
-    for f in ("valid", "eol", "eof") + (("cam",) if stream.stereo else ()):
-        if not isinstance(getattr(stream, f).val, bool):
-            raise _fail(f"port {name}: field {f} must be a Signal(bool), got {_what(getattr(stream, f))}")
+    check_port(name, stream, ImageStream)
     if width is not None and stream.data_width != width:
         raise _fail(f"port {name} must carry {width}-bit data, got an ImageStream of {stream.data_width} bits")
     if stream.stereo and stereo is False:
@@ -177,35 +190,41 @@ def check_stream(name: str, stream, *, width: int | None = None, stereo: bool | 
 
 def check_axis(name: str, port, *, data_width: int | None = None) -> None:
     """An :class:`~eyestereo.hdl.interfaces.axis.AxiStream` port carrying ``data_width``-bit pixels."""
-    if not isinstance(port, AxiStream):
-        raise _fail(f"port {name} must be an AxiStream, got {_what(port)}")
-    for f in port.fields():
-        sig = getattr(port, f, None)
-        if not isinstance(sig, _Signal):
-            raise _fail(f"port {name}: field {f} of the AxiStream is {_what(sig)}, not a Signal")
+    check_port(name, port, AxiStream)
     if data_width is not None and port.data_width != data_width:
         raise _fail(f"port {name} must carry {data_width}-bit pixels, got an AxiStream of {port.data_width} bits")
 
 
 def check_distinct(outputs: dict, inputs: dict) -> None:
-    """No signal of an output port may belong to any other port: ``sobel(clk, rst, s, s)`` is refused.
+    """No signal a block drives may belong to any other port: ``sobel(clk, rst, s, s)`` is refused.
 
-    ``outputs`` and ``inputs`` map port names to ports (Signals or ImageStreams); inputs may share
-    signals among themselves (a signal can feed two inputs), an output drives its signals alone.
+    ``outputs`` and ``inputs`` map port names to ports, Signals or bundles. A Signal among ``outputs``
+    is driven by the block. A bundle among ``outputs`` is one the block produces (the source of a
+    stream, the master of a request port): it drives the members the bundle declares ``out``; a bundle
+    among ``inputs`` is one it consumes (serves): it drives the members declared ``in`` (a queue's
+    ``ready``, a fetch port's ``req_ready`` and responses). The directions come from the bundle's
+    declaration (:mod:`eyestereo.hdl.interfaces.bundle`), so a caller names whole bundles, never their
+    members. Signals a block only reads may be shared (a signal can feed two inputs). A bundle class
+    without a declaration is skipped.
     """
-    def signals(port):
-        if isinstance(port, (ImageStream, AxiStream)):  # an AxiStream's tready is an input: still its own
-            return [getattr(port, f) for f in port.fields()]
-        return [port] if isinstance(port, _Signal) else []
+    def signals(port, producer: bool):
+        """(signal, driven by the block) of a port."""
+        if isinstance(port, Bundle):
+            driven = set(port.driven(producer))
+            return [(getattr(port, f), f in driven) for f in port.fields()]
+        return [(port, producer)] if isinstance(port, _Signal) else []
 
-    owner: dict[int, str] = {}
-    for name, port in list(outputs.items()) + list(inputs.items()):
-        for sig in signals(port):
-            other = owner.get(id(sig))
-            if other is not None and (other in outputs or name in outputs):
-                raise _fail(f"ports {other} and {name} share a signal; the output port "
-                            f"{other if other in outputs else name} needs signals of its own")
-            owner.setdefault(id(sig), name)
+    owner: dict[int, tuple[str, bool]] = {}
+    for producer, ports in ((True, outputs), (False, inputs)):
+        for name, port in ports.items():
+            for sig, driven in signals(port, producer):
+                other = owner.get(id(sig))
+                if other is not None and other[0] != name and (other[1] or driven):
+                    out = other[0] if other[1] else name
+                    raise _fail(f"ports {other[0]} and {name} share a signal; the output port {out} "
+                                f"needs signals of its own")
+                if other is None or driven:  # the same port again (or a new one): remember if it drives
+                    owner[id(sig)] = (name, driven or bool(other and other[1]))
 
 
 def check_int(name: str, value, lo: int | None = None, hi: int | None = None) -> int:

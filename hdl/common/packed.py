@@ -6,9 +6,10 @@ The model, the catalogue, the bench and the block all take a word's layout from 
     unpack_word(sink.data, SOBEL, ix=ix, iy=iy)    # ix, iy: signals sized like the fields
     pack_word(word, SOBEL, ix=qx, iy=qy)           # word: Signal(intbv(0)[SOBEL.width:])
 
-Both are combinational. Signed fields are signals with ``min < 0`` (MyHDL declares them ``signed``); their
-bits enter the word through an unsigned copy, because VHDL does not assign a ``signed`` slice to an
-``unsigned`` vector, and leave it through a reinterpreting assignment.
+Both are combinational. :class:`FieldSignals` makes one signal per field, sized from the declaration, for
+a block that packs or unpacks every field. Signed fields are signals with ``min < 0`` (MyHDL declares them
+``signed``); their bits enter the word through an unsigned copy, because VHDL does not assign a ``signed``
+slice to an ``unsigned`` vector, and leave it through a reinterpreting assignment.
 """
 
 from myhdl import ConcatSignal, Signal, always_comb, block, intbv
@@ -27,6 +28,31 @@ def _check(packed: PackedWord, name: str, sig, role: str) -> None:
     if signed != f.fmt.signed:
         raise ValueError(f"{role}: field {name!r} of {packed.name} is {f.fmt}, its signal is "
                          f"{'signed' if signed else 'unsigned'}")
+
+
+class FieldSignals:
+    """One signal per field of a :class:`~eyestereo.tools.packed.PackedWord`, as attributes (``sigs.dx``).
+
+    Each is sized from its field's format (signed fields signed); the 1-bit fields named in ``flags`` are
+    ``bool`` signals, the others intbv. An interface for sub-blocks; ``pack_word(word, packed,
+    **sigs.fields())`` / ``unpack_word(word, packed, **sigs.fields())`` move them all at once.
+    """
+
+    def __init__(self, packed: PackedWord, flags: tuple[str, ...] = ()):
+        for f in packed.fields:
+            if f.name in flags:
+                if f.fmt.wl != 1:
+                    raise ValueError(f"FieldSignals: flag {f.name!r} of {packed.name} is {f.fmt}, not 1 bit")
+                sig = Signal(bool(0))
+            elif f.fmt.signed:
+                sig = Signal(intbv(0, min=-(1 << (f.fmt.wl - 1)), max=1 << (f.fmt.wl - 1)))
+            else:
+                sig = Signal(intbv(0)[f.fmt.wl:])
+            setattr(self, f.name, sig)
+
+    def fields(self) -> dict:
+        """Field name -> signal, in declaration order."""
+        return dict(vars(self))
 
 
 @block

@@ -15,7 +15,7 @@ import argparse
 import json
 import sys
 from collections import defaultdict
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 
 #: Spartan-3E -4 cell delays in ns (data sheet DS312 switching characteristics; rounded): LUT input to
@@ -63,7 +63,7 @@ def analyse(netlist: dict, top: str) -> dict:
                     if isinstance(b, int):
                         sinks[cn].append((port, b))
 
-    @lru_cache(maxsize=None)
+    @cache
     def arrival(bit: int) -> tuple[float, tuple]:
         """Arrival time at a net and the path (cell names) that sets it."""
         if bit not in drivers:
@@ -114,12 +114,12 @@ def estimate(name: str, out: Path, *, job: dict | None = None, **params) -> dict
     """Estimate the clock period of ``name`` on the netlist ``make synth`` maps: the block's VHDL
     synthesized by GHDL (:func:`eyestereo.hdl.flow.synth.prepare`), then Yosys ``synth_xilinx -family xc3se``.
     ``job``: a job :func:`~eyestereo.hdl.flow.synth.prepare` made already (its netlist is reused)."""
-    from eyestereo.hdl.flow.synth import _yosys, prepare
+    from eyestereo.hdl.flow.synth import prepare, yosys
 
     if job is None:
         job = prepare(name, Path(out), label=f"sta_{name}", **params)
     d = Path(job["dir"])
-    _yosys(f"read_verilog {job['netlist']}; synth_xilinx -family xc3se -noiopad -top {name}; "
+    yosys(f"read_verilog {job['netlist']}; synth_xilinx -family xc3se -noiopad -top {name}; "
            f"write_json xc3se_netlist.json", d, "yosys_sta.log")
     res = analyse(json.loads((d / "xc3se_netlist.json").read_text()), name)
     res["block"] = name

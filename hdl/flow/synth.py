@@ -181,7 +181,7 @@ def _latches(log: Path) -> list[str]:
             if "Latch inferred" in l and not l.lstrip().startswith("No latch")]
 
 
-def _yosys(script: str, cwd: Path, log: str) -> None:
+def yosys(script: str, cwd: Path, log: str) -> None:
     r = subprocess.run(yosys_command() + ["-q", "-l", log, "-p", script], cwd=cwd, capture_output=True, text=True)
     if r.returncode != 0:
         raise RuntimeError(f"yosys failed in {cwd} (see {cwd / log}):\n{r.stdout[-2000:]}{r.stderr[-2000:]}")
@@ -212,7 +212,7 @@ def prepare(name: str, out: Path, *, label: str | None = None, **params) -> dict
 def xc3se(job: dict) -> dict:
     """Yosys ``synth_xilinx -family xc3se`` of a prepared job: cell counts and their summary."""
     d = Path(job["dir"])
-    _yosys(f"read_verilog {job['netlist']}; synth_xilinx -family xc3se -noiopad -top {job['block']}; "
+    yosys(f"read_verilog {job['netlist']}; synth_xilinx -family xc3se -noiopad -top {job['block']}; "
            f"tee -q -o stat.txt stat", d, "yosys_xc3se.log")
     cells = parse_stat((d / "stat.txt").read_text())
     s = summarize(cells)
@@ -235,7 +235,7 @@ def parse_fmax(report: dict, clocks: list[str]) -> dict[str, dict]:
 def ecp5(job: dict, *, freq: float = 100.0, seed: int = 1) -> dict:
     """Yosys ``synth_ecp5`` + nextpnr-ecp5 of a prepared job: fmax per clock and the ECP5 utilisation."""
     d = Path(job["dir"])
-    _yosys(f"read_verilog {job['netlist']}; synth_ecp5 -top {job['block']} -json ecp5.json", d, "yosys_ecp5.log")
+    yosys(f"read_verilog {job['netlist']}; synth_ecp5 -top {job['block']} -json ecp5.json", d, "yosys_ecp5.log")
     clocks = list(job["clocks"])
     (d / "ecp5.lpf").write_text("".join(f'FREQUENCY PORT "{c}" {freq:.1f} MHz;\n' for c in clocks))
     t0 = time.perf_counter()

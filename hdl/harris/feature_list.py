@@ -1,13 +1,15 @@
-"""Feature list: stereo corner flags in, feature words (x, y, camera) out on a queue port, counts per frame (thesis 7.1-7.2)."""
+"""Feature list: stereo corner flags in, feature words (x, y, cam) out on a queue port, counts (thesis 7.1-7.2)."""
 
 from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv
 
 from eyestereo.hdl.common.checks import (block_error, check_clock, check_distinct, check_frame, check_int,
                                          check_reset, check_signal, check_stream, checked)
 from eyestereo.hdl.common.fifo import sync_fifo
-from eyestereo.hdl.interfaces.queue import QueuePort, check_queue
+from eyestereo.hdl.harris.block_position import block_position
+from eyestereo.hdl.interfaces.queue import check_queue
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH, THRESHOLD_BLOCKS
 from eyestereo.tools.models import feature_list as model
-from eyestereo.tools.models.prethreshold import block_edges, check_blocks
+from eyestereo.tools.models.prethreshold import check_blocks
 
 KIND_FEATURE, KIND_TRAILER, KIND_TOKEN = 0, 1, 2
 
@@ -24,8 +26,8 @@ def addr_bits(blocks) -> int:
 
 @block
 def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, total_right, overflow, frame_done, *,
-                 width: int = 352, height: int = 288, blocks: tuple[int, int] = (4, 4), border: int = 4,
-                 max_features: int = 1023, depth: int = 16):
+                 width: int = FRAME_WIDTH, height: int = FRAME_HEIGHT, blocks: tuple[int, int] = THRESHOLD_BLOCKS,
+                 border: int = 4, max_features: int = 1023, depth: int = 16):
     """The features of each stereo frame as a list of words on a queue port, and their counts.
 
     Every set flag at least ``border`` pixels from each edge is a feature (x, y, cam). Its 32-bit word
@@ -64,7 +66,8 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
     measured by the bench).
     Throughput: one word per clock, one feature per 2 clocks sustained; the FIFO absorbs bursts.
 
-    Resources: the FIFO (34 x depth LUT-RAM), 2 x 2 x BX BY counters in LUT-RAM, position counters.
+    Resources: the FIFO (34 x depth LUT-RAM), 2 x 2 x BX BY counters in LUT-RAM, the
+    block position counters (:func:`~eyestereo.hdl.harris.block_position.block_position`).
     """
     check_clock(clk)
     check_reset(rst)
@@ -90,19 +93,11 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
     outs = dict(source=source, count_data=count_data, total_left=total_left, total_right=total_right,
                 overflow=overflow, frame_done=frame_done)
     check_distinct(outs, dict(clk=clk, rst=rst, sink=sink, count_addr=count_addr))
-    nblk = bxn * byn
 
-    # Position of the beat (moves on with the right camera's beat), its block, inside the border.
-    x_last = tuple(int(e) - 1 for e in block_edges(width, bxn)[1:])
-    y_last = tuple(int(e) - 1 for e in block_edges(height, byn)[1:])
+    # Position of the beat (one for both cameras), its block, inside the border.
     x = Signal(intbv(0, min=0, max=width))
     y = Signal(intbv(0, min=0, max=height))
-    bx = Signal(intbv(0, min=0, max=bxn))
-    by = Signal(intbv(0, min=0, max=byn))
-    base = Signal(intbv(0, min=0, max=nblk))
     blk = Signal(intbv(0)[ab - 1:])
-    xl = Signal(intbv(0, min=0, max=width))
-    yl = Signal(intbv(0, min=0, max=height))
     token = Signal(bool(0))
     last = Signal(bool(0))  # the right camera's beat of the frame's last pixel
     hit = Signal(bool(0))  # a listed feature on this beat (not "event": a Verilog keyword)
@@ -110,39 +105,10 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
 
     @always_comb
     def decode():
-        blk.next = base + bx
-        xl.next = x_last[bx]
-        yl.next = y_last[by]
         token.next = sink.valid and sink.eof and not sink.eol
         last.next = sink.valid and sink.eof and sink.eol and sink.cam
         hit.next = sink.valid and not (sink.eof and not sink.eol) and sink.data[0] and x >= x_lo and x < x_hi \
             and y >= y_lo and y < y_hi
-
-    @always_seq(clk.posedge, reset=rst)
-    def position():
-        if sink.valid and (sink.cam or (sink.eof and not sink.eol)):
-            if sink.eof:
-                x.next = 0
-                y.next = 0
-                bx.next = 0
-                by.next = 0
-                base.next = 0
-            elif sink.eol or x == width - 1:
-                x.next = 0
-                bx.next = 0
-                if y == height - 1:
-                    y.next = 0
-                    by.next = 0
-                    base.next = 0
-                else:
-                    y.next = y + 1
-                    if y == yl:
-                        by.next = by + 1
-                        base.next = base + bxn
-            else:
-                x.next = x + 1
-                if x == xl:
-                    bx.next = bx + 1
 
     # Counters: LUT-RAM of 2 banks x 2^ab entries, address (bank, block, cam); a "fresh" flag per entry
     # and bank says it was written in its bank's frame (a cleared flag reads as 0), so a bank is
@@ -295,5 +261,6 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
             else:
                 half.next = True
 
-    return [decode, position, caddr, cflags, cread, cwrite, entry, lists, serial, halves,
+    return [decode, block_position(clk, rst, sink, x, y, blk, width=width, height=height, blocks=(bxn, byn)),
+            caddr, cflags, cread, cwrite, entry, lists, serial, halves,
             sync_fifo(clk, rst, din, push, dout, pop, fcount, fvalid, depth=depth)]

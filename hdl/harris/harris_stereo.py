@@ -1,35 +1,35 @@
 """Stereo Harris corner detector: one datapath for both cameras, shared line delays and multipliers (thesis 6.3)."""
 
-from myhdl import block
+from myhdl import ConcatSignal, block
 
 from eyestereo.hdl.common.checks import (block_error, check_choice, check_clock, check_distinct, check_frame,
                                          check_reset, check_signal, check_stream, checked)
-from eyestereo.hdl.harris.cornerness_stereo import cornerness_stereo
-from eyestereo.hdl.harris.cornerness_stereo import latency as corner_latency
-from eyestereo.hdl.harris.cornerness_stereo import multipliers as corner_multipliers
-from eyestereo.hdl.harris.harris_window_stereo import harris_window_stereo
-from eyestereo.hdl.harris.harris_window_stereo import latency as window_latency
-from eyestereo.hdl.harris.harris_window_stereo import multipliers as window_multipliers
-from eyestereo.hdl.harris.nms_stereo import latency as nms_latency
-from eyestereo.hdl.harris.nms_stereo import lead as nms_lead
-from eyestereo.hdl.harris.nms_stereo import nms_stereo
-from eyestereo.hdl.harris.prethreshold_stereo import prethreshold_stereo
+from eyestereo.hdl.harris.cornerness import cornerness
+from eyestereo.hdl.harris.cornerness import latency as corner_latency
+from eyestereo.hdl.harris.cornerness import multipliers as corner_multipliers
+from eyestereo.hdl.harris.harris_window import harris_window
+from eyestereo.hdl.harris.harris_window import latency as window_latency
+from eyestereo.hdl.harris.harris_window import multipliers as window_multipliers
+from eyestereo.hdl.harris.nms import nms as nms_block
+from eyestereo.hdl.harris.nms import stereo_latency as nms_latency
+from eyestereo.hdl.harris.nms import stereo_lead as nms_lead
+from eyestereo.hdl.harris.prethreshold import prethreshold
 from eyestereo.hdl.harris.sobel import LATENCY as SOBEL_LATENCY
-from eyestereo.hdl.harris.sobel_stereo import sobel_stereo
+from eyestereo.hdl.harris.sobel import sobel
 from eyestereo.hdl.interfaces.stream import ImageStream
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import harris_window as window_model
 from eyestereo.tools.models import sobel as sobel_model
 from eyestereo.tools.models.harris_mono import k_code, radius, threshold_code  # noqa: F401 (re-export)
-from eyestereo.tools.models.harris_stereo import SHARES
+from eyestereo.tools.constants import SHARE_FACTORS
 from eyestereo.tools.models.prethreshold import check_blocks
 
 
 def latency(nms: int, share: int) -> tuple[int, int, int]:
     """(clocks, lines, pixels): camera c's flag (x, y) comes that many clocks after its input beat of pixel
-    (x + pixels, y + lines): Sobel 1 + window 2 + the NMS's :func:`~eyestereo.hdl.harris.nms_stereo.lead`."""
+    (x + pixels, y + lines): Sobel 1 + window 2 + the NMS's :func:`~eyestereo.hdl.harris.nms.stereo_lead`."""
     lines, pixels = nms_lead(nms)
-    return (SOBEL_LATENCY + window_latency(share) + corner_latency(share) + 1 + nms_latency(nms),
+    return (SOBEL_LATENCY + window_latency(share, stereo=True) + corner_latency(share) + 1 + nms_latency(nms),
             3 + lines, 3 + pixels)
 
 
@@ -45,8 +45,8 @@ def harris_stereo(clk, rst, sink, source, k_left, k_right, thr_we, thr_cam, thr_
     """Harris corners of both cameras of a stereo stream: ``source`` flag (x, y, cam) = a corner of that camera.
 
     Sobel -> window -> cornerness -> pre-threshold -> NMS as in :func:`~eyestereo.hdl.harris.harris_mono.harris_mono`,
-    each stage processing the left and right beats of the stereo stream in turn (``sobel_stereo``,
-    ``harris_window_stereo``, ``cornerness_stereo``, ``prethreshold_stereo``, ``nms_stereo``). The line
+    each stage processing the left and right beats of the stereo stream in turn (the same blocks as the mono
+    chain, each taking the camera count from its stereo sink). The line
     delays are stereo line delays (both cameras in one block RAM, 2 x width words); the multipliers are
     time-shared over ``share`` clocks: the window's three products take 3 / 2 / 1 multipliers and the
     cornerness's four take 4 / 2 / 2 for share 1 / 2 / 3 (7 / 4 / 3 in all; two mono detectors: 14).
@@ -98,7 +98,7 @@ def harris_stereo(clk, rst, sink, source, k_left, k_right, thr_we, thr_cam, thr_
                                              thr_we=thr_we, thr_cam=thr_cam, thr_addr=thr_addr, thr_data=thr_data))
     width, height = check_frame(width, height, min_size=5)
     nms = check_choice("nms", nms, (1, 3, 5))
-    share = check_choice("share", share, SHARES)
+    share = check_choice("share", share, SHARE_FACTORS)
     blocks = checked(check_blocks, width, height, blocks)
     abits = max(1, (blocks[0] * blocks[1] - 1).bit_length())
     if len(thr_addr) < abits:
@@ -108,10 +108,10 @@ def harris_stereo(clk, rst, sink, source, k_left, k_right, thr_we, thr_cam, thr_
     s_corner = ImageStream(corner_model.WORD, stereo=True)
     s_pre = ImageStream(corner_model.WORD, stereo=True)
     return [
-        sobel_stereo(clk, rst, sink, s_sobel, width=width, height=height, share=share),
-        harris_window_stereo(clk, rst, s_sobel, s_window, width=width, height=height, share=share),
-        cornerness_stereo(clk, rst, s_window, s_corner, k_left, k_right, share=share),
-        prethreshold_stereo(clk, rst, s_corner, s_pre, thr_we, thr_cam, thr_addr, thr_data, width=width,
-                            height=height, blocks=blocks),
-        nms_stereo(clk, rst, s_pre, source, width=width, height=height, size=nms, share=share),
+        sobel(clk, rst, sink, s_sobel, width=width, height=height, share=share),
+        harris_window(clk, rst, s_sobel, s_window, width=width, height=height, share=share),
+        cornerness(clk, rst, s_window, s_corner, k_left, k_right, width=width, height=height, share=share),
+        prethreshold(clk, rst, s_corner, s_pre, thr_we, ConcatSignal(thr_addr, thr_cam), thr_data, width=width,
+                     height=height, blocks=blocks),
+        nms_block(clk, rst, s_pre, source, width=width, height=height, size=nms, share=share),
     ]

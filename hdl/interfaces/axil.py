@@ -5,17 +5,18 @@ rising edge with both high. All signals are active high and sampled on the risin
 VHDL/Verilog ports come out as ``<arg>_<field>`` (``bus_awaddr``, ``bus_rready``, ...), the names
 Vivado's interface inference and cocotbext-axi's ``AxiLiteBus.from_prefix(dut, "bus")`` look for.
 
-Fields (direction seen from the slave, :func:`eyestereo.hdl.system.register_bank.register_bank`):
+Fields (their directions and widths are declared once, in ``AxiLite.MEMBERS``, from the master's side;
+docs/interfaces.md shows them; the slave is :func:`eyestereo.hdl.system.register_bank.register_bank`):
 
-``awaddr``, ``awprot`` (in), ``awvalid`` (in), ``awready`` (out)
+``awaddr``, ``awprot``, ``awvalid``, ``awready``
     Write address: a byte address of ``addr_bits`` bits; ``awprot`` is accepted and ignored.
-``wdata`` (in, 32 bits), ``wstrb`` (in, 4 bits), ``wvalid`` (in), ``wready`` (out)
+``wdata``, ``wstrb``, ``wvalid``, ``wready``
     Write data; ``wstrb`` bit i: byte i (bits 8i+7..8i) is written.
-``bresp`` (out, 2 bits), ``bvalid`` (out), ``bready`` (in)
+``bresp``, ``bvalid``, ``bready``
     Write response: 0 OKAY, 2 SLVERR.
-``araddr``, ``arprot`` (in), ``arvalid`` (in), ``arready`` (out)
+``araddr``, ``arprot``, ``arvalid``, ``arready``
     Read address.
-``rdata`` (out, 32 bits), ``rresp`` (out, 2 bits), ``rvalid`` (out), ``rready`` (in)
+``rdata``, ``rresp``, ``rvalid``, ``rready``
     Read data and response.
 
 Rules (both sides; ``eyestereo.sim.lib.axil.AxiLiteChecker`` checks them in every bench): a valid, once
@@ -54,15 +55,16 @@ from __future__ import annotations
 
 import numbers
 
-from myhdl import Signal, intbv
-
-from eyestereo.hdl.common.checks import block_error
+from eyestereo.hdl.common.checks import block_error, check_port
+from eyestereo.hdl.interfaces.bundle import IN, OUT, Bundle, Member
 
 __all__ = ["AxiLite", "check_axil"]
 
 
-class AxiLite:
-    """A MyHDL interface bundle for an AXI4-Lite slave port (see the module docstring).
+class AxiLite(Bundle):
+    """A MyHDL interface bundle for an AXI4-Lite slave port (see the module docstring). The declaration
+    is the master's view: ``out`` members are the master's outputs, ``in`` members the slave's
+    (``driven(producer=False)``).
 
     Parameters:
         addr_bits: byte-address bits (3..32); data is always 32 bits (4 byte strobes).
@@ -70,46 +72,27 @@ class AxiLite:
 
     DATA_BITS = 32
 
+    PARAMS = ("addr_bits",)
+    MEMBERS = (Member("awaddr", "addr_bits", OUT), Member("awprot", 3, OUT), Member("awvalid", bool, OUT),
+               Member("awready", bool, IN),
+               Member("wdata", DATA_BITS, OUT), Member("wstrb", DATA_BITS // 8, OUT), Member("wvalid", bool, OUT),
+               Member("wready", bool, IN),
+               Member("bresp", 2, IN), Member("bvalid", bool, IN), Member("bready", bool, OUT),
+               Member("araddr", "addr_bits", OUT), Member("arprot", 3, OUT), Member("arvalid", bool, OUT),
+               Member("arready", bool, IN),
+               Member("rdata", DATA_BITS, IN), Member("rresp", 2, IN), Member("rvalid", bool, IN),
+               Member("rready", bool, OUT))
+
     def __init__(self, addr_bits: int = 32):
         if isinstance(addr_bits, bool) or not isinstance(addr_bits, numbers.Integral) or not 3 <= addr_bits <= 32:
             raise ValueError(f"AxiLite addr_bits must be an int in [3, 32], got {addr_bits!r}")
         self.addr_bits = int(addr_bits)
-        self.awaddr = Signal(intbv(0)[self.addr_bits:])
-        self.awprot = Signal(intbv(0)[3:])
-        self.awvalid = Signal(bool(0))
-        self.awready = Signal(bool(0))
-        self.wdata = Signal(intbv(0)[32:])
-        self.wstrb = Signal(intbv(0)[4:])
-        self.wvalid = Signal(bool(0))
-        self.wready = Signal(bool(0))
-        self.bresp = Signal(intbv(0)[2:])
-        self.bvalid = Signal(bool(0))
-        self.bready = Signal(bool(0))
-        self.araddr = Signal(intbv(0)[self.addr_bits:])
-        self.arprot = Signal(intbv(0)[3:])
-        self.arvalid = Signal(bool(0))
-        self.arready = Signal(bool(0))
-        self.rdata = Signal(intbv(0)[32:])
-        self.rresp = Signal(intbv(0)[2:])
-        self.rvalid = Signal(bool(0))
-        self.rready = Signal(bool(0))
+        self.make()
 
-    def fields(self) -> list[str]:
-        return ["awaddr", "awprot", "awvalid", "awready", "wdata", "wstrb", "wvalid", "wready", "bresp", "bvalid",
-                "bready", "araddr", "arprot", "arvalid", "arready", "rdata", "rresp", "rvalid", "rready"]
-
-    #: the slave's outputs
-    OUTPUTS = ("awready", "wready", "bresp", "bvalid", "arready", "rdata", "rresp", "rvalid")
-
-    def __repr__(self) -> str:
-        return f"AxiLite(addr_bits={self.addr_bits})"
 
 
 def check_axil(name: str, port, *, addr_bits: int | None = None) -> None:
     """An :class:`AxiLite` port (of ``addr_bits`` address bits), else a ValueError naming the port and block."""
-    if not isinstance(port, AxiLite):
-        got = "None" if port is None else (f"{type(port).__name__} {port!r}"[:60] if isinstance(port, (int, str))
-                                           else type(port).__name__)
-        raise block_error(f"port {name} must be an AxiLite (awaddr, wdata, ..., rready), got {got}")
+    check_port(name, port, AxiLite)
     if addr_bits is not None and port.addr_bits != addr_bits:
         raise block_error(f"port {name} must have {addr_bits} address bits (the register map's), got {port.addr_bits}")

@@ -44,10 +44,7 @@ The WaveDrom form of this diagram is ``docs/wavedrom/axis_video.json`` (``make t
 
 from __future__ import annotations
 
-import numbers
-
-from myhdl import Signal, intbv
-
+from eyestereo.hdl.interfaces.bundle import IN, OUT, Bundle, Member, word_width
 from eyestereo.tools.packed import PackedWord
 
 
@@ -56,30 +53,22 @@ def tdata_width(data_width: int) -> int:
     return 8 * ((int(data_width) + 7) // 8)
 
 
-class AxiStream:
+class AxiStream(Bundle):
     """A MyHDL interface bundle for an AXI4-Stream video port (see the module docstring for the protocol).
 
     Parameters:
         data_width: bits of the pixel it carries (the image stream's ``data_width``), or a
             :class:`~eyestereo.tools.packed.PackedWord`; ``tdata`` has that many bits rounded up to
-            whole bytes.
+            whole bytes (``tdata_bits``).
     """
 
-    def __init__(self, data_width: int | PackedWord = 8):
-        if isinstance(data_width, PackedWord):
-            data_width = data_width.width
-        if isinstance(data_width, bool) or not isinstance(data_width, numbers.Integral) or data_width < 1:
-            raise ValueError(f"AxiStream data_width must be an int >= 1 or a PackedWord, got {data_width!r}")
-        self.data_width = int(data_width)
-        self.tdata = Signal(intbv(0)[tdata_width(data_width):])
-        self.tvalid = Signal(bool(0))
-        self.tready = Signal(bool(0))
-        self.tlast = Signal(bool(0))
-        self.tuser = Signal(bool(0))
+    MEMBERS = (Member("tdata", "tdata_bits", OUT), Member("tvalid", bool, OUT), Member("tready", bool, IN),
+               Member("tlast", bool, OUT), Member("tuser", bool, OUT))
 
-    def fields(self) -> list[str]:
-        """Names of the signal fields, in port order."""
-        return ["tdata", "tvalid", "tready", "tlast", "tuser"]
+    def __init__(self, data_width: int | PackedWord = 8):
+        self.data_width, _ = word_width("AxiStream", data_width)
+        self.tdata_bits = tdata_width(self.data_width)
+        self.make()
 
     def __repr__(self) -> str:
         return f"AxiStream(data_width={self.data_width}, tdata={len(self.tdata)} bits)"

@@ -40,27 +40,23 @@ Python side (timing, schedules, byte orders) is :mod:`eyestereo.tools.camera`, t
 
 import numbers
 
-from myhdl import Signal, intbv
+from eyestereo.hdl.interfaces.bundle import OUT, Bundle, Member
 
 
-class CameraBus:
-    """A MyHDL interface bundle for one camera port (see the module docstring for the timing).
+class CameraBus(Bundle):
+    """A MyHDL interface bundle for one camera port (see the module docstring for the timing); the camera
+    is the producer of every member.
 
     Parameters:
         data_width: bits of ``data`` (8 for the OV6630's 8-bit mode).
     """
 
+    PARAMS = ("data_width",)
+    MEMBERS = (Member("pclk", bool, OUT), Member("vsync", bool, OUT), Member("href", bool, OUT),
+               Member("data", "data_width", OUT))
+
     def __init__(self, data_width: int = 8):
         if isinstance(data_width, bool) or not isinstance(data_width, numbers.Integral) or data_width < 1:
             raise ValueError(f"CameraBus data_width must be an int >= 1, got {data_width!r}")
         self.data_width = int(data_width)
-        self.pclk = Signal(bool(0))
-        self.vsync = Signal(bool(0))
-        self.href = Signal(bool(0))
-        self.data = Signal(intbv(0)[self.data_width:])
-
-    def fields(self) -> list[str]:
-        return ["pclk", "vsync", "href", "data"]
-
-    def __repr__(self) -> str:
-        return f"CameraBus(data_width={self.data_width})"
+        self.make()

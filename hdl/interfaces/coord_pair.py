@@ -52,23 +52,28 @@ FAI) takes P0 in clock 2 instead of 1 and keeps the same rate.
 
 from __future__ import annotations
 
-from myhdl import Signal, intbv
-
 from eyestereo.hdl.common.checks import check_int
+from eyestereo.hdl.interfaces.bundle import IN, OUT, Bundle, Member
 from eyestereo.tools.models import poly_unit as model
 
 __all__ = ["CoordPair"]
 
 
-class CoordPair:
-    """A MyHDL interface bundle for the coordinate pair handshake (see the module docstring).
+class CoordPair(Bundle):
+    """A MyHDL interface bundle for the coordinate pair handshake (see the module docstring); the warper
+    is the producer.
 
     Parameters:
-        source_width, source_height: the camera images (>= 2 each); they size the coordinates.
+        source_width, source_height: the camera images (>= 2 each); they size the coordinates
+            (``x_bits``, ``y_bits``: the word lengths of ``x_format``, ``y_format``).
         frac: fraction bits of the coordinates (0..16).
     """
 
-    FIELDS = ("valid", "read_ack", "xl", "yl", "xr", "yr", "oor_l", "oor_r", "eol", "eof")
+    MEMBERS = (Member("valid", bool, OUT), Member("read_ack", bool, IN),
+               Member("xl", "x_bits", OUT), Member("yl", "y_bits", OUT),
+               Member("xr", "x_bits", OUT), Member("yr", "y_bits", OUT),
+               Member("oor_l", bool, OUT), Member("oor_r", bool, OUT),
+               Member("eol", bool, OUT), Member("eof", bool, OUT))
 
     def __init__(self, source_width: int, source_height: int, frac: int):
         self.source_width = check_int("source_width", source_width, 2, 65536)
@@ -76,20 +81,8 @@ class CoordPair:
         self.frac = check_int("frac", frac, 0, model.MAX_FRAC)
         self.x_format = model.coord_format(self.frac, self.source_width)
         self.y_format = model.coord_format(self.frac, self.source_height)
-        self.valid = Signal(bool(0))
-        self.read_ack = Signal(bool(0))
-        self.xl = Signal(intbv(0)[self.x_format.wl:])
-        self.yl = Signal(intbv(0)[self.y_format.wl:])
-        self.xr = Signal(intbv(0)[self.x_format.wl:])
-        self.yr = Signal(intbv(0)[self.y_format.wl:])
-        self.oor_l = Signal(bool(0))
-        self.oor_r = Signal(bool(0))
-        self.eol = Signal(bool(0))
-        self.eof = Signal(bool(0))
-
-    def fields(self) -> list[str]:
-        """Names of the signal fields, in port order."""
-        return list(self.FIELDS)
+        self.x_bits, self.y_bits = self.x_format.wl, self.y_format.wl
+        self.make()
 
     def __repr__(self) -> str:
         return (f"CoordPair(source {self.source_width}x{self.source_height}, x {self.x_format}, "

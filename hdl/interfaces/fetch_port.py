@@ -47,9 +47,9 @@ from __future__ import annotations
 
 import numbers
 
-from myhdl import Signal, intbv
-
-from eyestereo.hdl.common.checks import block_error
+from eyestereo.hdl.common.checks import check_port
+from eyestereo.hdl.interfaces.bundle import IN, OUT, Bundle, Member
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_MAX, FRAME_MIN, FRAME_WIDTH
 
 __all__ = ["FetchPort", "MASK_BITS", "OFFSETS", "check_fetch"]
 
@@ -58,35 +58,25 @@ MASK_BITS = 4
 OFFSETS = ((1, 1), (0, 1), (1, 0), (0, 0))
 
 
-class FetchPort:
-    """A pixel fetch port bundle for ``width`` x ``height`` source images (see the module docstring)."""
+class FetchPort(Bundle):
+    """A pixel fetch port bundle for ``width`` x ``height`` source images (see the module docstring); the
+    rectifier is the producer (master), the memory side the consumer (slave)."""
 
-    def __init__(self, width: int = 352, height: int = 288):
+    PARAMS = ("width", "height")
+    MEMBERS = (Member("req_valid", bool, OUT), Member("req_ready", bool, IN),
+               Member("req_x", "width", OUT, ranged=True), Member("req_y", "height", OUT, ranged=True),
+               Member("req_cam", bool, OUT), Member("req_mask", MASK_BITS, OUT),
+               Member("rsp_valid", bool, IN), Member("rsp_idx", 2, IN), Member("rsp_data", 8, IN))
+
+    def __init__(self, width: int = FRAME_WIDTH, height: int = FRAME_HEIGHT):
         for name, v in (("width", width), ("height", height)):
-            if isinstance(v, bool) or not isinstance(v, numbers.Integral) or not 2 <= v <= 4096:
-                raise ValueError(f"FetchPort {name} must be an int in [2, 4096], got {v!r}")
+            if isinstance(v, bool) or not isinstance(v, numbers.Integral) or not FRAME_MIN <= v <= FRAME_MAX:
+                raise ValueError(f"FetchPort {name} must be an int in [{FRAME_MIN}, {FRAME_MAX}], got {v!r}")
         self.width, self.height = int(width), int(height)
-        self.req_valid = Signal(bool(0))
-        self.req_ready = Signal(bool(0))
-        self.req_x = Signal(intbv(0, min=0, max=self.width))
-        self.req_y = Signal(intbv(0, min=0, max=self.height))
-        self.req_cam = Signal(bool(0))
-        self.req_mask = Signal(intbv(0)[MASK_BITS:])
-        self.rsp_valid = Signal(bool(0))
-        self.rsp_idx = Signal(intbv(0)[2:])
-        self.rsp_data = Signal(intbv(0)[8:])
+        self.make()
 
-    def fields(self) -> list[str]:
-        return ["req_valid", "req_ready", "req_x", "req_y", "req_cam", "req_mask", "rsp_valid", "rsp_idx",
-                "rsp_data"]
-
-    def __repr__(self) -> str:
-        return f"FetchPort(width={self.width}, height={self.height})"
 
 
 def check_fetch(name: str, port) -> None:
     """A :class:`FetchPort` port, else a ValueError naming the port and the block."""
-    if not isinstance(port, FetchPort):
-        got = "None" if port is None else (f"{type(port).__name__} {port!r}"[:60] if isinstance(port, (int, str))
-                                           else type(port).__name__)
-        raise block_error(f"port {name} must be a FetchPort (req_*, rsp_*), got {got}")
+    check_port(name, port, FetchPort)

@@ -42,46 +42,30 @@ that ends the cycle)::
     moves             *    *         *    *    *    *
 """
 
-import numbers
-
-from myhdl import Signal, intbv
-
-from eyestereo.hdl.common.checks import block_error
+from eyestereo.hdl.common.checks import block_error, check_port
+from eyestereo.hdl.interfaces.bundle import IN, OUT, Bundle, Member, word_width
 from eyestereo.tools.packed import PackedWord
 
 
-class QueuePort:
+class QueuePort(Bundle):
     """A MyHDL interface bundle for one queue read port (see the module docstring for the handshake).
 
     Parameters:
         data_width: bits of ``data``, or the :class:`~eyestereo.tools.packed.PackedWord` it carries.
     """
 
+    PARAMS = ("data_width",)
+    MEMBERS = (Member("data", "data_width", OUT), Member("valid", bool, OUT), Member("ready", bool, IN),
+               Member("eol", bool, OUT), Member("eof", bool, OUT))
+
     def __init__(self, data_width: int | PackedWord = 16):
-        self.word = None
-        if isinstance(data_width, PackedWord):
-            self.word = data_width
-            data_width = data_width.width
-        if isinstance(data_width, bool) or not isinstance(data_width, numbers.Integral) or data_width < 1:
-            raise ValueError(f"QueuePort data_width must be an int >= 1 or a PackedWord, got {data_width!r}")
-        self.data_width = int(data_width)
-        self.data = Signal(intbv(0)[self.data_width:])
-        self.valid = Signal(bool(0))
-        self.ready = Signal(bool(0))
-        self.eol = Signal(bool(0))
-        self.eof = Signal(bool(0))
+        self.data_width, self.word = word_width("QueuePort", data_width)
+        self.make()
 
-    def fields(self) -> list[str]:
-        return ["data", "valid", "ready", "eol", "eof"]
-
-    def __repr__(self) -> str:
-        return f"QueuePort(data_width={self.data_width})"
 
 
 def check_queue(name: str, port, *, width: int | None = None) -> None:
     """A :class:`QueuePort` port of ``width`` data bits, else a ValueError naming the port."""
-    if not isinstance(port, QueuePort):
-        what = "None" if port is None else type(port).__name__
-        raise block_error(f"port {name} must be a QueuePort (valid/ready/data/eol/eof), got {what}")
+    check_port(name, port, QueuePort)
     if width is not None and port.data_width != width:
         raise block_error(f"port {name} must carry {width}-bit data, got a QueuePort of {port.data_width} bits")

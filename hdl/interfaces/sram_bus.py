@@ -1,4 +1,4 @@
-"""The SRAM's pins and the controller's word port: the two sides of :func:`~eyestereo.hdl.memory.sram_controller.sram_controller`.
+"""The SRAM, both sides: its pins and the word port of :func:`~eyestereo.hdl.memory.sram_controller.sram_controller`.
 
 **Pins** (:class:`SramPins`, the FPGA's side of the 1M x 18 synchronous SRAM; the part, its two kinds and
 the rules it imposes are documented in :mod:`eyestereo.tools.sram`). Ports come out as ``<arg>_<field>``,
@@ -13,15 +13,16 @@ e.g. ``sram_addr``, ``sram_ce_n``:
 ``dq_i`` (16 bits)
     Input from the DQ buffers; the controller registers it at once (the input flip-flop of the I/O block).
 
-**Word port** (:class:`SramCmd` in, :class:`SramRsp` out): one access per command, in order::
+**Word port** (:class:`SramCmd` in, :class:`SramRsp` out; the members' directions and widths are declared
+once in each class's ``MEMBERS``, shown in docs/interfaces.md): one access per command, in order::
 
-    cmd_valid  in   an access is offered: cmd_we (1 write, 0 read), cmd_addr, cmd_wdata, cmd_be, cmd_tag
-    cmd_ready  out  the controller takes it (it moves on a rising edge with cmd_valid & cmd_ready)
-    cmd_be     in   2 bits, the bytes a write changes (bit 1: 15..8, bit 0: 7..0); ignored for reads
-    cmd_tag    in   any bits the master wants back with the read data (the arbiter: who asked)
-    rsp_valid  out  one clock per read, in command order, no back-pressure
-    rsp_data   out  16 bits, the word read
-    rsp_tag    out  the read's cmd_tag
+    cmd_valid  an access is offered: cmd_we (1 write, 0 read), cmd_addr, cmd_wdata, cmd_be, cmd_tag
+    cmd_ready  the controller takes it (it moves on a rising edge with cmd_valid & cmd_ready)
+    cmd_be     2 bits, the bytes a write changes (bit 1: 15..8, bit 0: 7..0); ignored for reads
+    cmd_tag    any bits the master wants back with the read data (the arbiter: who asked)
+    rsp_valid  one clock per read, in command order, no back-pressure
+    rsp_data   16 bits, the word read
+    rsp_tag    the read's cmd_tag
 
 ``cmd_ready`` is low only for a write on a pipelined part while the bus turns round after reads (it
 depends on ``cmd_we`` and registered state, nothing else); reads are always taken, and on a NoBL part
@@ -61,9 +62,8 @@ from __future__ import annotations
 
 import numbers
 
-from myhdl import Signal, intbv
-
-from eyestereo.hdl.common.checks import block_error
+from eyestereo.hdl.common.checks import block_error, check_port
+from eyestereo.hdl.interfaces.bundle import IN, OUT, Bundle, Member
 from eyestereo.tools.sram import ADDR_BITS, DATA_BITS
 
 __all__ = ["SramPins", "SramCmd", "SramRsp", "HostPort", "StatPort", "check_bundle"]
@@ -71,8 +71,11 @@ __all__ = ["SramPins", "SramCmd", "SramRsp", "HostPort", "StatPort", "check_bund
 
 def check_bundle(name: str, port, cls) -> None:
     """An interface port of class ``cls`` (SramPins, SramCmd, ..., FrameControl), else a ValueError that
-    names the port and the block."""
-    if not isinstance(port, cls):
+    names the port and the block. A declared bundle (:class:`~eyestereo.hdl.interfaces.bundle.Bundle`)
+    has its members checked too (:func:`~eyestereo.hdl.common.checks.check_port`)."""
+    if isinstance(cls, type) and issubclass(cls, Bundle):
+        check_port(name, port, cls)
+    elif not isinstance(port, cls):
         got = "None" if port is None else (f"{type(port).__name__} {port!r}"[:60] if isinstance(port, (int, str))
                                            else type(port).__name__)
         fields = f" ({', '.join(cls().fields())})" if hasattr(cls, "fields") else ""
@@ -85,76 +88,74 @@ def _bits(name: str, value, lo: int, hi: int) -> int:
     return int(value)
 
 
-class SramPins:
-    """The FPGA's pins to the SRAM (see the module docstring); all outputs reset-free registers in the controller."""
+class _Word(Bundle):
+    """A word port's parameters, checked: ``addr_bits``, ``data_bits`` (whole bytes: ``be_bits`` byte
+    enables), ``tag_bits``; the ones a class has no member for stay unset."""
+
+    def _sizes(self, addr_bits: int | None = None, data_bits: int | None = None, tag_bits: int | None = None) -> None:
+        kind = type(self).__name__
+        if addr_bits is not None:
+            self.addr_bits = _bits(f"{kind} addr_bits", addr_bits, 1, 24)
+        if data_bits is not None:
+            self.data_bits = _bits(f"{kind} data_bits", data_bits, 8, 32)
+            if self.data_bits % 8:
+                raise ValueError(f"{kind} data_bits must be a multiple of 8, got {data_bits}")
+            self.be_bits = self.data_bits // 8
+        if tag_bits is not None:
+            self.tag_bits = _bits(f"{kind} tag_bits", tag_bits, 1, 16)
+        self.make()
+
+
+class SramPins(_Word):
+    """The FPGA's pins to the SRAM (see the module docstring); all outputs reset-free registers in the
+    controller. The FPGA is the producer: ``dq_i`` is the one member the part drives."""
+
+    PARAMS = ("addr_bits", "data_bits")
+    MEMBERS = (Member("addr", "addr_bits", OUT), Member("ce_n", bool, OUT, init=1), Member("ld_n", bool, OUT),
+               Member("we_n", bool, OUT, init=1), Member("bw_n", "be_bits", OUT, init=-1),
+               Member("oe_n", bool, OUT, init=1), Member("dq_o", "data_bits", OUT), Member("dq_oe", bool, OUT),
+               Member("dq_i", "data_bits", IN))
 
     def __init__(self, addr_bits: int = ADDR_BITS, data_bits: int = DATA_BITS):
-        self.addr_bits = _bits("SramPins addr_bits", addr_bits, 1, 24)
-        self.data_bits = _bits("SramPins data_bits", data_bits, 8, 32)
-        if self.data_bits % 8:
-            raise ValueError(f"SramPins data_bits must be a multiple of 8, got {data_bits}")
-        nb = self.data_bits // 8
-        self.addr = Signal(intbv(0)[self.addr_bits:])
-        self.ce_n = Signal(bool(1))
-        self.ld_n = Signal(bool(0))
-        self.we_n = Signal(bool(1))
-        self.bw_n = Signal(intbv((1 << nb) - 1)[nb:])
-        self.oe_n = Signal(bool(1))
-        self.dq_o = Signal(intbv(0)[self.data_bits:])
-        self.dq_oe = Signal(bool(0))
-        self.dq_i = Signal(intbv(0)[self.data_bits:])
-
-    def fields(self) -> list[str]:
-        return ["addr", "ce_n", "ld_n", "we_n", "bw_n", "oe_n", "dq_o", "dq_oe", "dq_i"]
+        self._sizes(addr_bits, data_bits)
 
 
-class SramCmd:
+class SramCmd(_Word):
     """Word port, command side (master -> controller): valid/ready, we, addr, wdata, be, tag."""
 
+    PARAMS = ("addr_bits", "data_bits", "tag_bits")
+    MEMBERS = (Member("valid", bool, OUT), Member("ready", bool, IN), Member("we", bool, OUT),
+               Member("addr", "addr_bits", OUT), Member("wdata", "data_bits", OUT), Member("be", "be_bits", OUT),
+               Member("tag", "tag_bits", OUT))
+
     def __init__(self, addr_bits: int = ADDR_BITS, data_bits: int = DATA_BITS, tag_bits: int = 1):
-        self.addr_bits = _bits("SramCmd addr_bits", addr_bits, 1, 24)
-        self.data_bits = _bits("SramCmd data_bits", data_bits, 8, 32)
-        self.tag_bits = _bits("SramCmd tag_bits", tag_bits, 1, 16)
-        self.valid = Signal(bool(0))
-        self.ready = Signal(bool(0))
-        self.we = Signal(bool(0))
-        self.addr = Signal(intbv(0)[self.addr_bits:])
-        self.wdata = Signal(intbv(0)[self.data_bits:])
-        self.be = Signal(intbv(0)[self.data_bits // 8:])
-        self.tag = Signal(intbv(0)[self.tag_bits:])
-
-    def fields(self) -> list[str]:
-        return ["valid", "ready", "we", "addr", "wdata", "be", "tag"]
+        self._sizes(addr_bits, data_bits, tag_bits)
 
 
-class SramRsp:
+class SramRsp(_Word):
     """Word port, read data (controller -> master): valid, data, tag; no back-pressure."""
 
+    PARAMS = ("data_bits", "tag_bits")
+    MEMBERS = (Member("valid", bool, OUT), Member("data", "data_bits", OUT), Member("tag", "tag_bits", OUT))
+
     def __init__(self, data_bits: int = DATA_BITS, tag_bits: int = 1):
-        self.data_bits = _bits("SramRsp data_bits", data_bits, 8, 32)
-        self.tag_bits = _bits("SramRsp tag_bits", tag_bits, 1, 16)
-        self.valid = Signal(bool(0))
-        self.data = Signal(intbv(0)[self.data_bits:])
-        self.tag = Signal(intbv(0)[self.tag_bits:])
-
-    def fields(self) -> list[str]:
-        return ["valid", "data", "tag"]
+        self._sizes(data_bits=data_bits, tag_bits=tag_bits)
 
 
-class HostPort:
+class HostPort(_Word):
     """The host's word port into the SRAM (the processor bus bridge of the complete system is its master).
 
-    Fields (ports ``<arg>_<field>``)::
+    Fields (ports ``<arg>_<field>``; directions and widths: ``MEMBERS``, docs/interfaces.md)::
 
-        req_valid  in   a request is offered, held until it moves
-        req_ready  out  the arbiter takes it (it moves on a rising edge with req_valid & req_ready)
-        req_we     in   1 write, 0 read
-        req_addr   in   20-bit word address (the whole SRAM; the frame buffers' map is
-                        eyestereo.tools.models.sram_arbiter.AddressMap)
-        req_wdata  in   16 bits
-        req_be     in   2 bits, the bytes a write changes (bit 1: 15..8, bit 0: 7..0)
-        rsp_valid  out  one clock per read, in request order, no back-pressure
-        rsp_data   out  the word read
+        req_valid  a request is offered, held until it moves
+        req_ready  the arbiter takes it (it moves on a rising edge with req_valid & req_ready)
+        req_we     1 write, 0 read
+        req_addr   20-bit word address (the whole SRAM; the frame buffers' map is
+                   eyestereo.tools.models.sram_arbiter.AddressMap)
+        req_wdata  16 bits
+        req_be     2 bits, the bytes a write changes (bit 1: 15..8, bit 0: 7..0)
+        rsp_valid  one clock per read, in request order, no back-pressure
+        rsp_data   the word read
 
     Writes are posted (no response); a read after a write to the same address returns the written word.
     The arbiter takes one request per two clocks at most (``req_ready`` comes from a register)::
@@ -166,23 +167,16 @@ class HostPort:
         rsp_valid  _    _    _    _    _        #     the read of cycle 0; n depends on the load
     """
 
+    PARAMS = ("addr_bits", "data_bits")
+    MEMBERS = (Member("req_valid", bool, OUT), Member("req_ready", bool, IN), Member("req_we", bool, OUT),
+               Member("req_addr", "addr_bits", OUT), Member("req_wdata", "data_bits", OUT),
+               Member("req_be", "be_bits", OUT), Member("rsp_valid", bool, IN), Member("rsp_data", "data_bits", IN))
+
     def __init__(self, addr_bits: int = ADDR_BITS, data_bits: int = DATA_BITS):
-        self.addr_bits = _bits("HostPort addr_bits", addr_bits, 1, 24)
-        self.data_bits = _bits("HostPort data_bits", data_bits, 8, 32)
-        self.req_valid = Signal(bool(0))
-        self.req_ready = Signal(bool(0))
-        self.req_we = Signal(bool(0))
-        self.req_addr = Signal(intbv(0)[self.addr_bits:])
-        self.req_wdata = Signal(intbv(0)[self.data_bits:])
-        self.req_be = Signal(intbv(0)[self.data_bits // 8:])
-        self.rsp_valid = Signal(bool(0))
-        self.rsp_data = Signal(intbv(0)[self.data_bits:])
-
-    def fields(self) -> list[str]:
-        return ["req_valid", "req_ready", "req_we", "req_addr", "req_wdata", "req_be", "rsp_valid", "rsp_data"]
+        self._sizes(addr_bits, data_bits)
 
 
-class StatPort:
+class StatPort(Bundle):
     """Read port of the arbiter's counters and frame-buffer status: ``addr`` in, ``data`` (32 bits) out
     two clocks later (a two-stage registered multiplexer; the register map is ``STAT`` in
     eyestereo.tools.models.sram_arbiter)::
@@ -192,9 +186,10 @@ class StatPort:
         data   .    .    d0   d1
     """
 
-    def __init__(self, addr_bits: int = 5, data_bits: int = 32):
-        self.addr = Signal(intbv(0)[_bits("StatPort addr_bits", addr_bits, 1, 8):])
-        self.data = Signal(intbv(0)[_bits("StatPort data_bits", data_bits, 16, 64):])
+    PARAMS = ("addr_bits", "data_bits")
+    MEMBERS = (Member("addr", "addr_bits", OUT), Member("data", "data_bits", IN))
 
-    def fields(self) -> list[str]:
-        return ["addr", "data"]
+    def __init__(self, addr_bits: int = 5, data_bits: int = 32):
+        self.addr_bits = _bits("StatPort addr_bits", addr_bits, 1, 8)
+        self.data_bits = _bits("StatPort data_bits", data_bits, 16, 64)
+        self.make()

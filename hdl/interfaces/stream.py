@@ -55,14 +55,11 @@ emits frames of the geometry its docstring states (the sink's, for all filters),
 valid/eol/eof pattern per frame, after a latency given in the block's docstring.
 """
 
-import numbers
-
-from myhdl import Signal, intbv
-
+from eyestereo.hdl.interfaces.bundle import OUT, Bundle, Member, word_width
 from eyestereo.tools.packed import PackedWord
 
 
-class ImageStream:
+class ImageStream(Bundle):
     """A MyHDL interface bundle for one image stream (see the module docstring for the protocol).
 
     Parameters:
@@ -71,28 +68,13 @@ class ImageStream:
         stereo: add the ``cam`` field.
     """
 
+    PARAMS = ("data_width", "stereo")
+    MEMBERS = (Member("data", "data_width", OUT), Member("valid", bool, OUT), Member("eol", bool, OUT),
+               Member("eof", bool, OUT), Member("cam", bool, OUT, when="stereo"))
+
     def __init__(self, data_width: int | PackedWord = 8, *, stereo: bool = False):
-        self.word = None
-        if isinstance(data_width, PackedWord):
-            self.word = data_width
-            data_width = data_width.width
-        if isinstance(data_width, bool) or not isinstance(data_width, numbers.Integral) or data_width < 1:
-            raise ValueError(f"ImageStream data_width must be an int >= 1 or a PackedWord, got {data_width!r}")
+        self.data_width, self.word = word_width("ImageStream", data_width)
         if not isinstance(stereo, bool):
             raise ValueError(f"ImageStream stereo must be True or False, got {stereo!r}")
-        data_width = int(data_width)
-        self.data_width = data_width
         self.stereo = stereo
-        self.data = Signal(intbv(0)[data_width:])
-        self.valid = Signal(bool(0))
-        self.eol = Signal(bool(0))
-        self.eof = Signal(bool(0))
-        if stereo:
-            self.cam = Signal(bool(0))
-
-    def fields(self) -> list[str]:
-        """Names of the signal fields, in port order."""
-        return ["data", "valid", "eol", "eof"] + (["cam"] if self.stereo else [])
-
-    def __repr__(self) -> str:
-        return f"ImageStream(data_width={self.data_width}, stereo={self.stereo})"
+        self.make()

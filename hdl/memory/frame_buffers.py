@@ -37,6 +37,7 @@ from __future__ import annotations
 from myhdl import Signal, always_comb, always_seq, block, concat, intbv
 
 from eyestereo.hdl.common.checks import block_error, check_clock, check_reset
+from eyestereo.hdl.interfaces.bundle import IN, OUT, Bundle, Member
 
 __all__ = ["FrameControl", "double_buffer", "FREE", "WRITING", "FULL", "READING"]
 
@@ -44,20 +45,23 @@ FREE, WRITING, FULL, READING = 0, 1, 2, 3
 COUNT_BITS = 16
 
 
-class FrameControl:
-    """The frame handshake of the SRAM arbiter with the system's controller (ports ``<arg>_<field>``)::
+class FrameControl(Bundle):
+    """The frame handshake of the SRAM arbiter with the system's controller (ports ``<arg>_<field>``).
 
-        cam_run       in   2 bits: camera c captures every frame it can (bit c)
-        cam_arm       in   2 bits: a pulse on bit c captures camera c's next whole frame once
-        cam_want      in   the rectifier side wants a camera pair: both cameras' newest FULL buffers are
-                           taken together as soon as both have one
-        cam_held      out  a pair is held: the fetch port reads it
-        cam_buf       out  2 bits: the buffer held of camera 0 (bit 0) and camera 1 (bit 1)
-        cam_release   in   pulse: release the pair (only after the last response of the last request:
-                           the buffers are written again at once)
+    Members, widths and directions are declared once in ``MEMBERS`` (``out``: the controller drives it,
+    ``in``: the arbiter; docs/interfaces.md lists them). What they mean:
+
+        cam_run       2 bits: camera c captures every frame it can (bit c)
+        cam_arm       2 bits: a pulse on bit c captures camera c's next whole frame once
+        cam_want      the rectifier side wants a camera pair: both cameras' newest FULL buffers are
+                      taken together as soon as both have one
+        cam_held      a pair is held: the fetch port reads it
+        cam_buf       2 bits: the buffer held of camera 0 (bit 0) and camera 1 (bit 1)
+        cam_release   pulse: release the pair (only after the last response of the last request:
+                      the buffers are written again at once)
         rect_want / rect_held / rect_buf / rect_release    the same for the rectified images (the host
         feat_want / feat_held / feat_buf / feat_release    reads buffer rect_buf / feat_buf)
-        avail         out  4 bits: a FULL frame waits in camera 0, camera 1, rectified, features (bit 0..3)
+        avail         4 bits: a FULL frame waits in camera 0, camera 1, rectified, features (bit 0..3)
 
     A ``*_want`` held high takes the newest frame whenever none is held; a ``*_release`` pulse and a
     ``*_want`` in the same clock release the held frame and take the next one in a later clock.
@@ -70,54 +74,41 @@ class FrameControl:
         cam_release  _    _    _    _    #    _    _
     """
 
-    def __init__(self):
-        self.cam_run = Signal(intbv(0)[2:])
-        self.cam_arm = Signal(intbv(0)[2:])
-        self.cam_want = Signal(bool(0))
-        self.cam_held = Signal(bool(0))
-        self.cam_buf = Signal(intbv(0)[2:])
-        self.cam_release = Signal(bool(0))
-        self.rect_want = Signal(bool(0))
-        self.rect_held = Signal(bool(0))
-        self.rect_buf = Signal(bool(0))
-        self.rect_release = Signal(bool(0))
-        self.feat_want = Signal(bool(0))
-        self.feat_held = Signal(bool(0))
-        self.feat_buf = Signal(bool(0))
-        self.feat_release = Signal(bool(0))
-        self.avail = Signal(intbv(0)[4:])
-
-    def fields(self) -> list[str]:
-        return ["cam_run", "cam_arm", "cam_want", "cam_held", "cam_buf", "cam_release", "rect_want", "rect_held",
-                "rect_buf", "rect_release", "feat_want", "feat_held", "feat_buf", "feat_release", "avail"]
-
-
-class BufferSide:
-    """Signals between a writer and its :func:`double_buffer` (internal to the arbiter)."""
+    MEMBERS = (Member("cam_run", 2, OUT), Member("cam_arm", 2, OUT), Member("cam_want", bool, OUT),
+               Member("cam_held", bool, IN), Member("cam_buf", 2, IN), Member("cam_release", bool, OUT),
+               Member("rect_want", bool, OUT), Member("rect_held", bool, IN), Member("rect_buf", bool, IN),
+               Member("rect_release", bool, OUT), Member("feat_want", bool, OUT), Member("feat_held", bool, IN),
+               Member("feat_buf", bool, IN), Member("feat_release", bool, OUT), Member("avail", 4, IN))
 
     def __init__(self):
-        # producer: a registered request/answer, so that no combinational path crosses
-        self.p_start = Signal(bool(0))      # level: a frame wants a buffer (held until answered)
-        self.p_grant = Signal(bool(0))      # pulse: it got buffer p_gbuf
-        self.p_gbuf = Signal(bool(0))
-        self.p_deny = Signal(bool(0))       # pulse: no buffer: the frame is dropped (counted)
-        self.p_avail = Signal(bool(0))      # (internal) a buffer can be taken now
-        self.p_pick = Signal(bool(0))       # (internal) which
-        self.p_done = Signal(bool(0))       # pulse: the frame in buffer p_done_buf is complete
-        self.p_done_buf = Signal(bool(0))
-        self.p_abort = Signal(bool(0))      # pulse: the frame in buffer p_abort_buf is abandoned
-        self.p_abort_buf = Signal(bool(0))
-        # consumer
-        self.c_take = Signal(bool(0))       # take the newest FULL buffer (only while c_avail and not held)
-        self.c_release = Signal(bool(0))
-        self.c_avail = Signal(bool(0))      # a FULL buffer can be taken
-        self.c_held = Signal(bool(0))
-        self.c_buf = Signal(bool(0))        # the held buffer (the last one held when none is)
-        # status
-        self.state = Signal(intbv(0)[4:])   # buffer 1's state in bits 3..2, buffer 0's in 1..0
-        self.published = Signal(intbv(0)[COUNT_BITS:])
-        self.dropped = Signal(intbv(0)[COUNT_BITS:])
-        self.overwritten = Signal(intbv(0)[COUNT_BITS:])
+        self.make()
+
+
+class BufferSide(Bundle):
+    """Signals between a writer, its reader and their :func:`double_buffer` (internal to the arbiter).
+
+    ``out`` members are driven by the writer (``p_*``) or the reader (``c_take``, ``c_release``), ``in``
+    members by the double buffer. The producer's request and answer are registered, so that no
+    combinational path crosses: ``p_start`` (level: a frame wants a buffer, held until answered),
+    ``p_grant`` (pulse: it got buffer ``p_gbuf``), ``p_deny`` (pulse: no buffer, the frame is dropped and
+    counted), ``p_avail``/``p_pick`` (a buffer can be taken now / which), ``p_done`` (pulse: the frame in
+    buffer ``p_done_buf`` is complete), ``p_abort`` (pulse: the frame in ``p_abort_buf`` is abandoned).
+    The consumer: ``c_take`` (take the newest FULL buffer, only while ``c_avail`` and not held),
+    ``c_release``, ``c_avail`` (a FULL buffer can be taken), ``c_held``, ``c_buf`` (the held buffer; the
+    last one held when none is). Status: ``state`` (buffer 1's state in bits 3..2, buffer 0's in 1..0) and
+    the counters ``published``, ``dropped``, ``overwritten``.
+    """
+
+    MEMBERS = (Member("p_start", bool, OUT), Member("p_grant", bool, IN), Member("p_gbuf", bool, IN),
+               Member("p_deny", bool, IN), Member("p_avail", bool, IN), Member("p_pick", bool, IN),
+               Member("p_done", bool, OUT), Member("p_done_buf", bool, OUT), Member("p_abort", bool, OUT),
+               Member("p_abort_buf", bool, OUT), Member("c_take", bool, OUT), Member("c_release", bool, OUT),
+               Member("c_avail", bool, IN), Member("c_held", bool, IN), Member("c_buf", bool, IN),
+               Member("state", 4, IN), Member("published", COUNT_BITS, IN), Member("dropped", COUNT_BITS, IN),
+               Member("overwritten", COUNT_BITS, IN))
+
+    def __init__(self):
+        self.make()
 
 
 @block

@@ -1,20 +1,32 @@
 """SRAM arbiter: six masters of their own kinds share the SRAM controller's word port."""
 
-from myhdl import ConcatSignal, Signal, always, always_comb, always_seq, block, concat, intbv
+from myhdl import ConcatSignal, Signal, always, always_comb, always_seq, block, concat, downrange, intbv
 
 from eyestereo.hdl.common.checks import (block_error, check_choice, check_clock, check_distinct, check_frame,
                                          check_int, check_reset, check_stream)
+from eyestereo.hdl.common.packed import unpack_word
+from eyestereo.hdl.common.registers import assign
 from eyestereo.hdl.interfaces.fetch_port import check_fetch
 from eyestereo.hdl.memory.frame_buffers import BufferSide, FrameControl, double_buffer
 from eyestereo.hdl.interfaces.queue import check_queue
 from eyestereo.hdl.interfaces.sram_bus import HostPort, SramCmd, SramRsp, StatPort, check_bundle
-from eyestereo.hdl.memory.sram_masters import (ENTRY_BITS, Head, camera_in, feature_in, fetch_slave, frame_writer, host_slave,
-                                        rect_in)
-from eyestereo.tools.models.sram_arbiter import MASTERS, AddressMap
+from eyestereo.hdl.memory.sram_masters import (ACCESS, TAG_BITS, EntrySignals, Head, camera_in, feature_in,
+                                               fetch_slave, frame_writer, host_slave, rect_in)
+from eyestereo.tools.models.sram_arbiter import MASTER_TABLE, AddressMap
 
-NM = len(MASTERS)
-CAM0, CAM1, FETCH, RECT, FEAT, HOST = range(NM)
-TAG_BITS = 3  # tag of a read: host << 2 | fetch index
+NM = len(MASTER_TABLE)
+
+
+def _check_port(master, port) -> None:
+    """A master's port is of the kind its engine serves."""
+    if master.engine in ("camera", "features"):
+        check_queue(master.name, port, width=16)
+    elif master.engine == "stereo":
+        check_stream(master.name, port, width=8, stereo=True)
+    elif master.engine == "fetch":
+        check_fetch(master.name, port)
+    else:
+        check_bundle(master.name, port, HostPort)
 
 
 def check_masters(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, *, width, height, feature_words, depth,
@@ -24,11 +36,9 @@ def check_masters(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, *, w
     and the address map."""
     check_clock(clk)
     check_reset(rst)
-    for name, port in (("cam0", cam0), ("cam1", cam1), ("feat", feat)):
-        check_queue(name, port, width=16)
-    check_fetch("fetch", fetch)
-    check_stream("rect", rect, width=8, stereo=True)
-    check_bundle("host", host, HostPort)
+    ports = dict(cam0=cam0, cam1=cam1, fetch=fetch, rect=rect, feat=feat, host=host)
+    for m in MASTER_TABLE:
+        _check_port(m, ports[m.name])
     check_bundle("ctl", ctl, FrameControl)
     check_bundle("stat", stat, StatPort)
     width, height = check_frame(width, height, min_size=2)
@@ -74,7 +84,10 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     words, from the cameras' async FIFOs); 2 ``fetch`` -- the rectifier's pixel fetch port (slave side);
     3 ``rect`` -- the rectified-image writer (stereo image stream of 8-bit pixels: left and right pixel
     of the same (x, y) packed into one word); 4 ``feat`` -- the feature-list writer (queue read port of
-    16-bit words, ``eof`` on a list's last word); 5 ``host`` -- the host port (reads and writes).
+    16-bit words, ``eof`` on a list's last word); 5 ``host`` -- the host port (reads and writes). They are
+    described once, in :data:`eyestereo.tools.models.sram_arbiter.MASTER_TABLE` (engine, urgency, burst
+    parameter, read tag); the arbiter builds each master's engine (hdl/memory/sram_masters.py), its place
+    in the round robin, its burst length and its counters from that table, in loops.
 
     Arbitration, one access per clock: the master owning the bus issues one access per clock while it
     has one, for up to its burst length (writers: ``burst``; fetch: ``fetch_burst`` reads, i.e. whole
@@ -123,7 +136,8 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     first pixel comes 11 clocks after the request is taken, a host read's word 7 clocks after; each
     waits longer while other masters hold the bus.
 
-    Resources: see docs/sram.md (Yosys, Spartan-3E).
+    Resources: see docs/sram.md (Yosys, Spartan-3E); with the defaults about 1360 LUTs, 77 LUT-RAM
+    (the writers' FIFOs), 1480 flip-flops (two thirds of them the 32-bit counters).
     """
     width, height, feature_words, depth, burst, fetch_burst, host_burst, counter_bits, amap = check_masters(
         clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, width=width, height=height,
@@ -137,15 +151,18 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
                                                              feat=feat, host=host, ctl=ctl, rsp=rsp))
 
     insts = []
-    heads = [Head() for _ in range(NM)]
-    sides = [BufferSide() for _ in range(4)]  # cam0, cam1, rect, feat
+    ports = dict(cam0=cam0, cam1=cam1, fetch=fetch, rect=rect, feat=feat, host=host)
+    params = dict(burst=burst, fetch_burst=fetch_burst, host_burst=host_burst)
+    heads = [Head(m) for m in MASTER_TABLE]
+    writers = [m.name for m in MASTER_TABLE if m.writer]
+    sides = [BufferSide() for _ in writers]  # one double buffer per writer, in the table's order
+    side_of = dict(zip(writers, sides))
     for sd in sides:
         insts.append(double_buffer(clk, rst, sd))
 
     # ---- frame handshake ------------------------------------------------------------------------
     run0, run1, arm0, arm1 = (Signal(bool(0)) for _ in range(4))
-    cams_take = Signal(bool(0))
-    s_c0, s_c1, s_r, s_f = sides
+    s_c0, s_c1, s_r, s_f = (side_of[n] for n in ("cam0", "cam1", "rect", "feat"))
 
     @always_comb
     def control():
@@ -169,51 +186,40 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
         ctl.feat_held.next = s_f.c_held
         ctl.feat_buf.next = s_f.c_buf
 
-    full0, full1, full2, full3 = (Signal(bool(0)) for _ in range(4))
+    fulls = [Signal(bool(0)) for _ in sides]
+    insts += [any_full(sd.state, f) for sd, f in zip(sides, fulls)]
+    insts += [control, assign(ConcatSignal(*reversed(fulls)), ctl.avail)]
+    del fulls
 
-    @always_comb
-    def avail_bits():
-        ctl.avail.next = concat(full3, full2, full1, full0)
-
-    for sd, f in zip(sides, (full0, full1, full2, full3)):
-        insts.append(any_full(sd.state, f))
-    insts += [control, avail_bits]
-
-    # ---- writers ------------------------------------------------------------------------------
+    # ---- the masters' engines, from the table -----------------------------------------------------
     lbits = max(2, feature_words.bit_length())
     lcounts = [Signal(intbv(0)[lbits:]) for _ in range(2)]
     lovf = Signal(intbv(0)[2:])
     rect_lost = Signal(intbv(0)[16:])
-
-    def dummy_counts():
-        return Signal(intbv(0)[2:]), Signal(intbv(0)[2:]), Signal(intbv(0)[2:])
-
-    def fifo_signals():
-        return (Signal(intbv(0)[ENTRY_BITS:]), Signal(bool(0)), Signal(bool(0)),
-                Signal(intbv(0, min=0, max=depth + 1)))
-
-    wkw = dict(depth=depth, burst=burst)
-    for c, (q, run, arm) in enumerate(((cam0, run0, arm0), (cam1, run1, arm1))):
-        e_in, push, push_eof, count = fifo_signals()
-        insts.append(frame_writer(clk, rst, e_in, push, push_eof, count, heads[c], sides[c], *dummy_counts(),
-                                  base0=amap.camera(c, 0), base1=amap.camera(c, 1), urgent=True, **wkw))
-        insts.append(camera_in(clk, rst, q, push, e_in, push_eof, count, run, arm, depth=depth))
-    e_in, push, push_eof, count = fifo_signals()
-    # The rectified stream cannot wait either: its writer is urgent like the cameras' (its rate is bounded
-    # by the stream's: one word per two beats at most, in the system one per 8 fetch reads).
-    insts.append(frame_writer(clk, rst, e_in, push, push_eof, count, heads[RECT], s_r, *dummy_counts(),
-                              base0=amap.rectified(0), base1=amap.rectified(1), urgent=True, **wkw))
-    insts.append(rect_in(clk, rst, rect, push, e_in, push_eof, count, rect_lost, depth=depth))
-    e_in, push, push_eof, count = fifo_signals()
-    insts.append(frame_writer(clk, rst, e_in, push, push_eof, count, heads[FEAT], s_f, lcounts[0], lcounts[1], lovf,
-                              base0=amap.features(0), base1=amap.features(1), urgent=False, **wkw))
-    insts.append(feature_in(clk, rst, feat, push, e_in, push_eof, count, depth=depth, capacity=feature_words))
-
-    # ---- readers ------------------------------------------------------------------------------
-    bases = ((amap.camera(0, 0), amap.camera(0, 1)), (amap.camera(1, 0), amap.camera(1, 1)))
-    insts.append(fetch_slave(clk, rst, fetch, heads[FETCH], s_c0.c_buf, s_c1.c_buf, width=width, height=height,
-                             bases=bases))
-    insts.append(host_slave(clk, rst, host, heads[HOST]))
+    camera = dict(cam0=(run0, arm0), cam1=(run1, arm1))
+    for m, head in zip(MASTER_TABLE, heads):
+        port = ports[m.name]
+        if m.writer:
+            entry, push = EntrySignals(), Signal(bool(0))
+            count = Signal(intbv(0, min=0, max=depth + 1))
+            # only the feature lists keep their word counts (status words 20, 21); the others' are left open
+            counts = (*lcounts, lovf) if m.engine == "features" else (Signal(intbv(0)[2:]) for _ in range(3))
+            base0, base1 = amap.bases(m.name)
+            insts.append(frame_writer(clk, rst, entry, push, count, head, side_of[m.name], *counts, base0=base0,
+                                      base1=base1, depth=depth, burst=burst, urgent=m.urgent))
+            if m.engine == "camera":
+                insts.append(camera_in(clk, rst, port, push, entry, count, *camera[m.name], depth=depth))
+            elif m.engine == "stereo":
+                # (its rate is bounded by the stream's: one word per two beats at most, in the system one
+                # per 8 fetch reads; the table makes it urgent, like the cameras: it cannot wait)
+                insts.append(rect_in(clk, rst, port, push, entry, count, rect_lost, depth=depth))
+            else:
+                insts.append(feature_in(clk, rst, port, push, entry, count, depth=depth, capacity=feature_words))
+        elif m.engine == "fetch":
+            insts.append(fetch_slave(clk, rst, port, head, s_c0.c_buf, s_c1.c_buf, width=width, height=height,
+                                     bases=(amap.bases("cam0"), amap.bases("cam1"))))
+        else:
+            insts.append(host_slave(clk, rst, port, head))
 
     @always(clk.posedge)
     def responses():
@@ -233,11 +239,10 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     # issues one access per clock while it has one, for up to its burst length; the *next* owner is
     # chosen one clock ahead (registered) from the masters' registered start/urgent flags, round robin
     # from the current owner. The command to the controller is registered too (``slot``).
-    h0, h1, h2, h3, h4, h5 = heads
-    reqv = ConcatSignal(h5.req, h4.req, h3.req, h2.req, h1.req, h0.req)
-    startv = ConcatSignal(h5.start, h4.start, h3.start, h2.start, h1.start, h0.start)
-    urgv = ConcatSignal(h5.urgent, h4.urgent, h3.urgent, h2.urgent, h1.urgent, h0.urgent)
-    bursts = (burst, burst, fetch_burst, burst, burst, host_burst)
+    reqv = ConcatSignal(*(h.req for h in reversed(heads)))
+    startv = ConcatSignal(*(h.start for h in reversed(heads)))
+    urgv = ConcatSignal(*(h.urgent for h in reversed(heads)))
+    bursts = tuple(params[m.burst] for m in MASTER_TABLE)
     maxb = max(bursts)
     own = Signal(intbv(NM - 1, min=0, max=NM))
     own_v = Signal(bool(0))
@@ -264,11 +269,7 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     gv = Signal(intbv(0)[NM:])
     wantv = Signal(intbv(0)[NM:])
     slot_v = Signal(bool(0))
-    slot_we = Signal(bool(0))
-    slot_addr = Signal(intbv(0)[len(cmd.addr):])
-    slot_wdata = Signal(intbv(0)[len(cmd.wdata):])
-    slot_be = Signal(intbv(0)[2:])
-    slot_tag = Signal(intbv(0)[TAG_BITS:])
+    slot = Signal(intbv(0)[ACCESS.width:])
 
     @always_comb
     def urgency():
@@ -296,18 +297,11 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     def next_choice():
         # round robin: the lowest master above the current owner in the pool, else the lowest in it
         # (the owner itself comes last); the pool is the urgent masters if any, else all that ask
-        if cand[0]:
-            nxt_c.next = 0
-        elif cand[1]:
-            nxt_c.next = 1
-        elif cand[2]:
-            nxt_c.next = 2
-        elif cand[3]:
-            nxt_c.next = 3
-        elif cand[4]:
-            nxt_c.next = 4
-        else:
-            nxt_c.next = 5
+        k = NM - 1
+        for i in downrange(NM - 1):
+            if cand[i]:
+                k = i
+        nxt_c.next = k
         nxt_vc.next = cand != 0
         nxt_urgc.next = urg != 0
         # an urgent master ends a non-urgent turn, but only after that turn moved a word: every turn
@@ -320,12 +314,10 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
         iss = own_v and r and (not slot_v or cmd.ready) and not preempt
         issue.next = iss
         turn_over.next = not own_v or not r or preempt or (iss and beats == 1)
-        h0.grant.next = iss and own == CAM0
-        h1.grant.next = iss and own == CAM1
-        h2.grant.next = iss and own == FETCH
-        h3.grant.next = iss and own == RECT
-        h4.grant.next = iss and own == FEAT
-        h5.grant.next = iss and own == HOST
+        g = intbv(0)[NM:]
+        for i in range(NM):
+            g[i] = iss and own == i
+        gv.next = g
 
     @always_comb
     def burst_length():
@@ -353,71 +345,48 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
         elif cmd.ready:
             slot_v.next = False
 
-    @always(clk.posedge)
-    def slot():
-        if issue:
-            slot_tag.next = 0
-            if own == CAM0:
-                slot_we.next = h0.we
-                slot_addr.next = h0.addr
-                slot_wdata.next = h0.wdata
-                slot_be.next = h0.be
-            elif own == CAM1:
-                slot_we.next = h1.we
-                slot_addr.next = h1.addr
-                slot_wdata.next = h1.wdata
-                slot_be.next = h1.be
-            elif own == FETCH:
-                slot_we.next = h2.we
-                slot_addr.next = h2.addr
-                slot_tag.next = h2.idx
-            elif own == RECT:
-                slot_we.next = h3.we
-                slot_addr.next = h3.addr
-                slot_wdata.next = h3.wdata
-                slot_be.next = h3.be
-            elif own == FEAT:
-                slot_we.next = h4.we
-                slot_addr.next = h4.addr
-                slot_wdata.next = h4.wdata
-                slot_be.next = h4.be
-            else:
-                slot_we.next = h5.we
-                slot_addr.next = h5.addr
-                slot_wdata.next = h5.wdata
-                slot_be.next = h5.be
-                slot_tag.next = 4
+    # (one process, an if-elif chain on the owner: the cheapest multiplexer after synthesis; a tree of
+    # two-way multiplexers built in a loop costs LUTs, a list indexed by the owner an undefined netlist)
+    a0, a1, a2, a3, a4, a5 = (h.access for h in heads)
 
-    @always_comb
-    def command():
-        cmd.valid.next = slot_v
-        cmd.we.next = slot_we
-        cmd.addr.next = slot_addr
-        cmd.wdata.next = slot_wdata
-        cmd.be.next = slot_be
-        cmd.tag.next = slot_tag
+    @always(clk.posedge)
+    def slot_load():
+        if issue:
+            if own == 0:
+                slot.next = a0
+            elif own == 1:
+                slot.next = a1
+            elif own == 2:
+                slot.next = a2
+            elif own == 3:
+                slot.next = a3
+            elif own == 4:
+                slot.next = a4
+            else:
+                slot.next = a5
 
     @always_comb
     def bookkeeping():
-        gv.next = concat(h5.grant, h4.grant, h3.grant, h2.grant, h1.grant, h0.grant)
         w = intbv(0)[NM:]
         for i in range(NM):
             w[i] = startv[i] or (own_v and own == i and reqv[i])
         wantv.next = w
 
-    insts += [urgency, pools, masked, next_choice, issue_logic, burst_length, turn, slot, command, bookkeeping]
+    insts += [urgency, pools, masked, next_choice, issue_logic, burst_length, turn, slot_load, bookkeeping,
+              assign(slot_v, cmd.valid),
+              unpack_word(slot, ACCESS, we=cmd.we, addr=cmd.addr, wdata=cmd.wdata, be=cmd.be, tag=cmd.tag)]
 
     # ---- counters and status ----------------------------------------------------------------------
-    # (individual signals, no lists: a list of signals becomes a memory array in the Verilog, which
+    # (individual signals in the multiplexers, no lists: a list of signals becomes a memory array, which
     # synthesis turns into wide multiplexers)
     words = [Signal(intbv(0)[counter_bits:]) for _ in range(NM)]
     waits = [Signal(intbv(0)[counter_bits:]) for _ in range(NM)]
     clocks = Signal(intbv(0)[counter_bits:])
     one = Signal(bool(1))
-    for i in range(NM):
-        moved, waiting = Signal(bool(0)), Signal(bool(0))
-        insts.append(activity(gv, wantv, moved, waiting, index=i))
-        insts.append(counter(clk, rst, moved, words[i]))
+    for i, head in enumerate(heads):
+        waiting = Signal(bool(0))
+        insts.append(activity(gv, wantv, head.grant, waiting, index=i))
+        insts.append(counter(clk, rst, head.grant, words[i]))
         insts.append(counter(clk, rst, waiting, waits[i]))
     insts.append(counter(clk, rst, one, clocks))
     insts.append(stat_mux(clk, stat, words, waits, clocks, sides, rect_lost, lcounts, lovf))
@@ -425,12 +394,13 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
 
 
 @block
-def activity(gv, wantv, moved, waiting, *, index: int):
-    """Master ``index`` moved a word this clock / waited (asked or held a turn, not granted)."""
+def activity(gv, wantv, grant, waiting, *, index: int):
+    """Master ``index`` is granted an access (moves a word) this clock / waited (asked or held a turn, not
+    granted)."""
 
     @always_comb
     def comb():
-        moved.next = gv[index]
+        grant.next = gv[index]
         waiting.next = wantv[index] and not gv[index]
 
     return comb

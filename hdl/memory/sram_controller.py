@@ -3,7 +3,7 @@
 from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv
 
 from eyestereo.hdl.common.checks import block_error, check_choice, check_clock, check_distinct, check_int, check_reset
-from eyestereo.hdl.common.registers import delay
+from eyestereo.hdl.common.registers import delay, en_reg
 from eyestereo.hdl.interfaces.sram_bus import SramCmd, SramPins, SramRsp, check_bundle
 from eyestereo.tools.models.sram_controller import write_block_window
 from eyestereo.tools.sram import KINDS
@@ -119,12 +119,7 @@ def sram_controller(clk, rst, cmd, rsp, sram, *, kind: str = "nobl", read_latenc
         else:
             sram.bw_n.next = no_bytes
 
-    @always(clk.posedge)
-    def address_pins():
-        if fire:
-            sram.addr.next = cmd.addr
-
-    insts += [control_pins, address_pins]
+    insts += [control_pins, en_reg(clk, fire, cmd.addr, sram.addr)]
 
     # Write data: with the address on a pipelined SyncBurst part (ADSC# write), read_latency clocks later
     # on a NoBL part.
@@ -133,12 +128,7 @@ def sram_controller(clk, rst, cmd, rsp, sram, *, kind: str = "nobl", read_latenc
         def data_enable():
             sram.dq_oe.next = wfire
 
-        @always(clk.posedge)
-        def data_out():
-            if wfire:
-                sram.dq_o.next = cmd.wdata
-
-        insts += [data_enable, data_out]
+        insts += [data_enable, en_reg(clk, wfire, cmd.wdata, sram.dq_o)]
     else:
         wflags = Signal(intbv(0)[lat:])  # bit i: a write was taken i+1 clocks ago
         wd_first = Signal(intbv(0)[sram.data_bits:])

@@ -12,20 +12,30 @@ its next access on a :class:`Head` and learns by ``grant`` that the arbiter issu
 
 Writers buffer their words in a small LUT-RAM FIFO and ask for the bus in bursts (``start``: a burst's
 worth is waiting, or a frame's last word), so that writes come grouped and the bus turns round once per
-burst, not once per word.
+burst, not once per word. Which engine serves which port, and the engine's urgency, burst and read tag,
+come from the one description of the masters, :data:`eyestereo.tools.models.sram_arbiter.MASTER_TABLE`:
+the arbiter builds each master's :class:`Head` and engine from its entry.
 """
 
 from __future__ import annotations
 
-from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv
+from myhdl import ConcatSignal, Signal, always, always_comb, always_seq, block, concat, intbv
 
 from eyestereo.hdl.common.arith import shift_add
 from eyestereo.hdl.common.fifo import sync_fifo
+from eyestereo.hdl.common.packed import pack_word, unpack_word
+from eyestereo.tools.models.sram_arbiter import FETCH_OFFSETS, Master
+from eyestereo.tools.packed import PackedWord
 from eyestereo.tools.sram import ADDR_BITS, DATA_BITS
 
-# FIFO entry of the writers: data (15..0), sof (16), eof (17), list overflow (18), abort (19)
-ENTRY_BITS = DATA_BITS + 4
-SOF, EOF, OVF, ABT = DATA_BITS, DATA_BITS + 1, DATA_BITS + 2, DATA_BITS + 3
+#: FIFO entry of the writers: the word, its frame's first / last word, the list's overflow flag, an abort
+#: (a reset token: the frame is abandoned).
+ENTRY = PackedWord("writer FIFO entry", [("data", DATA_BITS), ("sof", 1), ("eof", 1), ("ovf", 1), ("abt", 1)])
+ENTRY_BITS = ENTRY.width
+#: Tag of a read on the controller's word port: the master's ``read_tag`` above the fetch index.
+TAG_BITS = 3
+#: One access as a master presents it and the arbiter passes it to the controller.
+ACCESS = PackedWord("access", [("addr", ADDR_BITS), ("wdata", DATA_BITS), ("we", 1), ("be", 2), ("tag", TAG_BITS)])
 
 
 class Head:
@@ -33,20 +43,41 @@ class Head:
 
     ``req``: an access is ready; ``start``: the master may start a turn (a writer: a burst is waiting);
     ``urgent``: it must be served before the round robin (the writers of streams that cannot wait);
-    ``we, addr, wdata, be``: the access; ``idx``: the fetch index returned with read data;
-    ``grant`` (from the arbiter): the access is issued at this edge.
+    ``we, addr, wdata, be``: the access; ``tag``: the read's tag (``read_tag`` above the fetch index);
+    ``grant`` (from the arbiter): the access is issued at this edge; ``access``: the access packed as
+    :data:`ACCESS`. The fields an engine does not drive keep the constant the master's description gives
+    them (a writer only writes whole words, the fetch port only reads, only writers are urgent).
     """
 
-    def __init__(self):
+    def __init__(self, master: Master):
         self.req = Signal(bool(0))
         self.start = Signal(bool(0))
         self.urgent = Signal(bool(0))
-        self.we = Signal(bool(0))
+        self.we = Signal(bool(master.writer))
         self.addr = Signal(intbv(0)[ADDR_BITS:])
         self.wdata = Signal(intbv(0)[DATA_BITS:])
         self.be = Signal(intbv(3)[2:])
-        self.idx = Signal(intbv(0)[2:])
+        self.tag = Signal(intbv(master.read_tag << 2)[TAG_BITS:])
         self.grant = Signal(bool(0))
+        self.access = self.packed()
+
+    def packed(self):
+        """The access packed as :data:`ACCESS` (a shadow signal of the fields)."""
+        return ConcatSignal(*(getattr(self, f.name) for f in reversed(ACCESS.fields)))
+
+
+class EntrySignals:
+    """A writer's FIFO entry as its input engine builds it: the engine drives the flags it has (``sof``;
+    ``ovf`` the feature lists, ``abt`` the streams with reset tokens; the others stay constant 0) and
+    ``pack_word(entry.word, ENTRY, data=..., eof=..., **entry.flags())`` packs them with its port's word
+    and ``eof`` into ``word`` (:data:`ENTRY`)."""
+
+    def __init__(self):
+        self.sof, self.ovf, self.abt = (Signal(bool(0)) for _ in range(3))
+        self.word = Signal(intbv(0)[ENTRY_BITS:])
+
+    def flags(self) -> dict:
+        return dict(sof=self.sof, ovf=self.ovf, abt=self.abt)
 
 
 # ------------------------------------------------------------------------------------------------------
@@ -63,26 +94,12 @@ def writer_issue(clk, rst, entry, valid, count, pop, push_eof, head, side, lcoun
     (``lcount0``/``lcount1``) and overflow flag (``lovf``). An abort entry (a reset token) abandons the
     frame (``side.p_abort``).
     """
-    waddr = Signal(intbv(0)[ADDR_BITS:])
+    waddr = head.addr
     eofs = Signal(intbv(0, min=0, max=depth + 1))  # entries with eof in the FIFO (frame ends, aborts)
     nwords = Signal(intbv(0)[len(lcount0):])       # words of the current frame issued so far
-    sof, eof, ovf, abt = (Signal(bool(0)) for _ in range(4))
-    has = Signal(bool(0))
-    claim = Signal(bool(0))
-    claimed = Signal(bool(0))
-    cur = Signal(bool(0))
-    discard = Signal(bool(0))
-    popped_eof = Signal(bool(0))
+    sof, eof, ovf, abt, has, claim, claimed, cur, discard, popped_eof = (Signal(bool(0)) for _ in range(10))
     cmax = (1 << len(lcount0)) - 1
-
-    @always_comb
-    def fields():
-        sof.next = entry[SOF]
-        eof.next = entry[EOF]
-        ovf.next = entry[OVF]
-        abt.next = entry[ABT]
-        head.wdata.next = entry[DATA_BITS:0]
-        head.addr.next = waddr
+    fields = unpack_word(entry, ENTRY, data=head.wdata, sof=sof, eof=eof, ovf=ovf, abt=abt)
 
     @always_comb
     def present():
@@ -90,9 +107,6 @@ def writer_issue(clk, rst, entry, valid, count, pop, push_eof, head, side, lcoun
         has.next = h
         claim.next = h and sof and not claimed and not abt and not discard
         head.req.next = h and not abt and not discard and (claimed or not sof)
-        head.we.next = True
-        head.be.next = 3
-        head.idx.next = 0
         # entries that leave the FIFO without an access: aborts, a dropped frame's words
         pop.next = head.grant or (h and (abt or discard or side.p_deny))
         side.p_done.next = head.grant and eof
@@ -156,22 +170,17 @@ def writer_issue(clk, rst, entry, valid, count, pop, push_eof, head, side, lcoun
 
 # ------------------------------------------------------------------------------------------------------
 @block
-def camera_in(clk, rst, q, push, entry_in, push_eof, count, run, arm, *, depth: int):
-    """A camera's queue read port into the writer FIFO.
+def camera_in(clk, rst, q, push, entry, count, run, arm, *, depth: int):
+    """A camera's queue read port into the writer FIFO (``entry``: :class:`EntrySignals`).
 
     A frame is captured when it starts while ``run`` is high or the camera is armed (an ``arm`` pulse,
     used up by the next frame captured); otherwise its words are taken and discarded. A reset token
     (``eof`` without ``eol``) in a captured frame becomes an abort entry. ``ready`` comes from the FIFO
     count register only.
     """
-    take = Signal(bool(0))
-    token = Signal(bool(0))
-    first = Signal(bool(0))
-    want = Signal(bool(0))
-    in_frame = Signal(bool(0))
-    cap = Signal(bool(0))
-    armed = Signal(bool(0))
-    zero = Signal(bool(0))  # never driven: a constant 0
+    take, want, in_frame, cap, armed = (Signal(bool(0)) for _ in range(5))
+    token, first = entry.abt, entry.sof
+    wires = pack_word(entry.word, ENTRY, data=q.data, eof=q.eof, **entry.flags())
 
     @always_comb
     def decide():
@@ -184,14 +193,8 @@ def camera_in(clk, rst, q, push, entry_in, push_eof, count, run, arm, *, depth: 
         want.next = run or armed
         if in_frame:
             push.next = t and cap
-            push_eof.next = t and cap and q.eof
         else:
             push.next = t and not tok and (run or armed)
-            push_eof.next = t and not tok and (run or armed) and q.eof
-
-    @always_comb
-    def pack():
-        entry_in.next = concat(token, zero, q.eof, first, q.data)
 
     @always_seq(clk.posedge, reset=rst)
     def frames():
@@ -208,24 +211,22 @@ def camera_in(clk, rst, q, push, entry_in, push_eof, count, run, arm, *, depth: 
             elif q.eof:
                 in_frame.next = False
 
-    return decide, pack, frames
+    return wires, decide, frames
 
 
 # ------------------------------------------------------------------------------------------------------
 @block
-def rect_in(clk, rst, s, push, entry_in, push_eof, count, overflows, *, depth: int):
+def rect_in(clk, rst, s, push, entry, count, overflows, *, depth: int):
     """The stereo image stream (8-bit, ``cam``) into the writer FIFO: one word per (x, y), left pixel in
     bits 7..0, right pixel in 15..8, pushed with the right pixel's beat; every frame is captured. The
     stream cannot wait: a word that finds the FIFO full is lost and counted in ``overflows`` (the
     arbiter's priorities keep it at 0). A reset token inside a frame becomes an abort entry.
     """
     left = Signal(intbv(0)[8:])
-    token = Signal(bool(0))
-    pair = Signal(bool(0))
-    in_frame = Signal(bool(0))
-    want = Signal(bool(0))
-    rfirst = Signal(bool(0))
-    zero = Signal(bool(0))  # never driven: a constant 0
+    pair, in_frame, want = (Signal(bool(0)) for _ in range(3))
+    token, rfirst = entry.abt, entry.sof
+    pixels = Signal(intbv(0)[DATA_BITS:])  # the word: right pixel (this beat) over the left one
+    wires = pack_word(entry.word, ENTRY, data=pixels, eof=s.eof, **entry.flags())
 
     @always_comb
     def decide():
@@ -236,12 +237,8 @@ def rect_in(clk, rst, s, push, entry_in, push_eof, count, overflows, *, depth: i
         w = pr or (tok and in_frame)
         want.next = w
         push.next = w and count != depth
-        push_eof.next = w and count != depth and s.eof
         rfirst.next = pr and not in_frame
-
-    @always_comb
-    def pack():
-        entry_in.next = concat(token, zero, s.eof, rfirst, s.data, left)
+        pixels.next = concat(s.data, left)
 
     @always_seq(clk.posedge, reset=rst)
     def frames():
@@ -254,23 +251,21 @@ def rect_in(clk, rst, s, push, entry_in, push_eof, count, overflows, *, depth: i
         elif pair:
             in_frame.next = not s.eof
 
-    return decide, pack, frames
+    return wires, decide, frames
 
 
 # ------------------------------------------------------------------------------------------------------
 @block
-def feature_in(clk, rst, q, push, entry_in, push_eof, count, *, depth: int, capacity: int):
+def feature_in(clk, rst, q, push, entry, count, *, depth: int, capacity: int):
     """Feature-list words (queue read port) into the writer FIFO, one list per buffer, ``eof`` on a
     list's last word. A list longer than the buffer's ``capacity`` keeps its first ``capacity - 1``
     words and its last one, and is flagged as overflowed.
     """
-    take = Signal(bool(0))
-    in_list = Signal(bool(0))
     n = Signal(intbv(0, min=0, max=capacity + 1))  # words of the list taken (saturating)
-    ovf = Signal(bool(0))
-    room = Signal(bool(0))  # the next word (if not the last) still has a slot: n < capacity - 1
-    ffirst = Signal(bool(0))
-    zero = Signal(bool(0))  # never driven: a constant 0
+    # room: the next word (if not the last) still has a slot, n < capacity - 1
+    take, in_list, room = (Signal(bool(0)) for _ in range(3))
+    ovf, ffirst = entry.ovf, entry.sof
+    wires = pack_word(entry.word, ENTRY, data=q.data, eof=q.eof, **entry.flags())
 
     @always_comb
     def decide():
@@ -279,15 +274,9 @@ def feature_in(clk, rst, q, push, entry_in, push_eof, count, *, depth: int, capa
         take.next = t
         if in_list:
             push.next = t and (room or q.eof)
-            push_eof.next = t and q.eof
         else:
             push.next = t
-            push_eof.next = t and q.eof
         ffirst.next = t and not in_list
-
-    @always_comb
-    def pack():
-        entry_in.next = concat(zero, ovf, q.eof, ffirst, q.data)
 
     @always_seq(clk.posedge, reset=rst)
     def lists():
@@ -307,7 +296,7 @@ def feature_in(clk, rst, q, push, entry_in, push_eof, count, *, depth: int, capa
                 if q.eof:
                     in_list.next = False
 
-    return decide, pack, lists
+    return wires, decide, lists
 
 
 # ------------------------------------------------------------------------------------------------------
@@ -331,14 +320,17 @@ def fetch_slave(clk, rst, fp, head, cbuf0, cbuf1, *, width: int, height: int, ba
     a_mask, b_mask, p_mask, c_mask = (Signal(intbv(0)[4:]) for _ in range(4))
     b_yx = Signal(intbv(0, min=0, max=yx_max + 1))
     base = Signal(intbv(0)[ADDR_BITS:])
-    p0, p1, p2, p3, c0, c1, c2, c3 = (Signal(intbv(0)[ADDR_BITS:]) for _ in range(8))
+    c0, c1, c2, c3 = cs = [Signal(intbv(0)[ADDR_BITS:]) for _ in FETCH_OFFSETS]
     c_idx = Signal(intbv(0)[2:])
     c_last = Signal(bool(0))
     move_a, move_b, move_p, move_c = (Signal(bool(0)) for _ in range(4))
     (l0b0, l0b1), (l1b0, l1b1) = bases
-    w1 = width + 1
 
     insts = [shift_add([(fp.req_y, width)], yw)]
+    # stages P and C of each neighbour's address (fetch index i: FETCH_OFFSETS[i])
+    insts += [neighbour_address(clk, move_b, move_p, base, b_yx, c, offset=dy * width + dx)
+              for c, (dx, dy) in zip(cs, FETCH_OFFSETS)]
+    del cs  # (the list stays out of the converted design: the addresses are plain signals)
 
     @always_comb
     def base_select():
@@ -373,11 +365,7 @@ def fetch_slave(clk, rst, fp, head, cbuf0, cbuf1, *, width: int, height: int, ba
     def present():
         head.req.next = c_v
         head.start.next = c_v
-        head.urgent.next = False
-        head.we.next = False
-        head.wdata.next = 0
-        head.be.next = 3
-        head.idx.next = c_idx
+        head.tag.next = c_idx
         fp.req_ready.next = not a_v
         # a stage moves on when the next one is empty or moves on itself
         mc = head.grant and c_last
@@ -417,16 +405,8 @@ def fetch_slave(clk, rst, fp, head, cbuf0, cbuf1, *, width: int, height: int, ba
             b_cam.next = a_cam
             b_mask.next = a_mask
         if move_b:
-            p0.next = base + b_yx + w1
-            p1.next = base + b_yx + width
-            p2.next = base + b_yx + 1
-            p3.next = base + b_yx
             p_mask.next = b_mask
         if move_p:
-            c0.next = p0
-            c1.next = p1
-            c2.next = p2
-            c3.next = p3
             c_mask.next = p_mask
         elif head.grant:
             if c_mask[0]:
@@ -440,6 +420,22 @@ def fetch_slave(clk, rst, fp, head, cbuf0, cbuf1, *, width: int, height: int, ba
 
     insts += [base_select, current, present, stages, data]
     return insts
+
+
+@block
+def neighbour_address(clk, move_b, move_p, base, b_yx, c, *, offset: int):
+    """One neighbour's address in the fetch pipeline: ``base + y * width + x + offset`` into stage P, then
+    stage C (``c``)."""
+    p = Signal(intbv(0)[len(c):])
+
+    @always(clk.posedge)
+    def stages():
+        if move_b:
+            p.next = base + b_yx + offset
+        if move_p:
+            c.next = p
+
+    return stages
 
 
 # ------------------------------------------------------------------------------------------------------
@@ -457,12 +453,10 @@ def host_slave(clk, rst, hp, head):
         hp.req_ready.next = not hv
         head.req.next = hv
         head.start.next = hv
-        head.urgent.next = False
         head.we.next = hwe
         head.addr.next = haddr
         head.wdata.next = hdata
         head.be.next = hbe
-        head.idx.next = 0
 
     @always_seq(clk.posedge, reset=rst)
     def valid():
@@ -483,14 +477,19 @@ def host_slave(clk, rst, hp, head):
 
 
 @block
-def frame_writer(clk, rst, entry_in, push, push_eof, count, head, side, lcount0, lcount1, lovf, *, base0: int,
-                 base1: int, depth: int, burst: int, urgent: bool):
+def frame_writer(clk, rst, entry, push, count, head, side, lcount0, lcount1, lovf, *, base0: int, base1: int,
+                 depth: int, burst: int, urgent: bool):
     """A writer's FIFO (LUT-RAM, ``depth`` entries) and its SRAM side (:func:`writer_issue`); the input side
-    (:func:`camera_in`, :func:`rect_in`, :func:`feature_in`) pushes ``entry_in``."""
-    entry = Signal(intbv(0)[ENTRY_BITS:])
-    pop = Signal(bool(0))
-    valid = Signal(bool(0))
-    fifo = sync_fifo(clk, rst, entry_in, push, entry, pop, count, valid, depth=depth)
-    issue = writer_issue(clk, rst, entry, valid, count, pop, push_eof, head, side, lcount0, lcount1, lovf, base0=base0,
+    (:func:`camera_in`, :func:`rect_in`, :func:`feature_in`) pushes ``entry`` (:class:`EntrySignals`)."""
+    word = Signal(intbv(0)[ENTRY_BITS:])
+    pop, valid, push_eof = (Signal(bool(0)) for _ in range(3))
+    eof_bit = ENTRY.bits("eof")[1]
+
+    @always_comb
+    def frame_end():
+        push_eof.next = push and entry.word[eof_bit]
+
+    fifo = sync_fifo(clk, rst, entry.word, push, word, pop, count, valid, depth=depth)
+    issue = writer_issue(clk, rst, word, valid, count, pop, push_eof, head, side, lcount0, lcount1, lovf, base0=base0,
                          base1=base1, depth=depth, burst=burst, urgent=urgent)
-    return fifo, issue
+    return frame_end, fifo, issue

@@ -14,7 +14,8 @@ def sram_subsystem(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, sra
                    read_latency: int = 2, width: int = 352, height: int = 288, feature_words: int = 8192,
                    depth: int = 16, burst: int = 8, fetch_burst: int = 8, host_burst: int = 1,
                    counter_bits: int = 32):
-    """:func:`~eyestereo.hdl.memory.sram_arbiter.sram_arbiter` on :func:`~eyestereo.hdl.memory.sram_controller.sram_controller`.
+    """:func:`~eyestereo.hdl.memory.sram_arbiter.sram_arbiter` on
+    :func:`~eyestereo.hdl.memory.sram_controller.sram_controller`.
 
     What the complete system instantiates: the masters' ports as the arbiter documents them, the frame
     handshake, the status port, and the SRAM's pins (:class:`~eyestereo.hdl.interfaces.sram_bus.SramPins`).

@@ -7,7 +7,8 @@ from myhdl import Signal, always_comb, always_seq, block, concat, intbv
 from eyestereo.hdl.common.checks import block_error, check_clock, check_distinct, check_int, check_reset, check_signal
 from eyestereo.hdl.common.registers import en_reg
 from eyestereo.hdl.interfaces.coord_pair import CoordPair
-from eyestereo.hdl.rectify.poly_unit import calibration_param, poly_unit
+from eyestereo.hdl.rectify.calibration import calibration_param
+from eyestereo.hdl.rectify.poly_unit import poly_unit
 from eyestereo.tools.models import poly_unit as unit_model
 
 __all__ = ["FIRST_PAIR", "coordinate_warper"]
@@ -50,15 +51,9 @@ def coordinate_warper(clk, rst, start, enable, busy, done, coord, coef=None, *, 
     after R1 fills and runs one clock after it empties). A consumer that takes each pair within four
     clocks never stops the unit: one pair every 4 clocks.
 
-    The handshake, with a timing diagram (pairs taken at once, after a wait, and the stall of the
-    unit), is documented in :mod:`eyestereo.hdl.interfaces.coord_pair`::
-
-        cycle      0   1   2   3   4   5   6   7   8   9  10  11  12  13  14  15  16  17  18  19
-        unit out  YR0 XL1 YL1 XR1 YR1 XL2 YL2 XR2 YR2 XL3 YL3 XR3 YR3 XL4 XL4 XL4 YL4 XR4 YR4 XL5
-        enable cu  #   #   #   #   #   #   #   #   #   #   #   #   #   _   _   #   #   #   #   #
-        valid      _   #   _   _   _   #   _   _   _   #   #   #   #   #   #   #   _   _   _   #
-        read_ack   _   #   _   _   _   #   _   _   _   _   _   _   _   _   #   #   _   _   _   #
-        pair       .  P0   .   .   .  P1   .   .   .  P2  P2  P2  P2  P2  P2  P3   .   .   .  P4
+    The handshake and its timing diagram (pairs taken at once, after a wait, and the stall of the unit:
+    ``enable cu`` low while both levels are full) are documented once, in
+    :mod:`eyestereo.hdl.interfaces.coord_pair` ("Timing").
 
     A frame: ``start`` (sampled while ``busy`` is low and ``enable`` high) begins one; ``busy`` is high
     from the next clock until the frame's last pair (``eof``) has been taken; ``done`` is high for the one
@@ -88,8 +83,8 @@ def coordinate_warper(clk, rst, start, enable, busy, done, coord, coef=None, *, 
 
     Parameters:
         quantizers, frac, source_width, source_height: as for :func:`~eyestereo.hdl.rectify.poly_unit.poly_unit`
-            (default: the synthetic rig, 352x288, frac = q24's fraction length, 5). The rectified size (the counters) is the
-            calibration's ``width`` x ``height``.
+            (default: the synthetic rig, 352x288, frac = q24's fraction length, 5). The rectified size (the
+            counters) is the calibration's ``width`` x ``height``.
 
     Latency: the first pair is offered 13 clocks after the ``start`` clock (:data:`FIRST_PAIR`); then one
     pair per 4 clocks while the consumer keeps up: ``done`` 4 x width x height + 10 clocks after ``start``.

@@ -2,18 +2,22 @@
 
 from __future__ import annotations
 
-from myhdl import Signal, always_comb, always_seq, block, concat, intbv
+from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv
 
-from eyestereo.hdl.common.checks import block_error, check_clock, check_distinct, check_int, check_reset, \
-    check_signal, check_stream
+from eyestereo.hdl.common.checks import (block_error, check_clock, check_distinct, check_int, check_reset,
+                                         check_signal, check_stream)
+from eyestereo.hdl.common.fifo import show_ahead_fifo
+from eyestereo.hdl.common.packed import FieldSignals, pack_word, unpack_word
 from eyestereo.hdl.interfaces.coord_pair import CoordPair
-from eyestereo.hdl.interfaces.fetch_port import FetchPort, check_fetch
+from eyestereo.hdl.interfaces.fetch_port import check_fetch
 from eyestereo.tools.models import fetch_interpolate as model
 
 __all__ = ["DEFAULT_DEPTH", "fetch_interpolate"]
 
 #: Default number of sides (requests or black pixels) in flight between the request and the output.
 DEFAULT_DEPTH = 4
+#: The 1-bit fields of the side word (:func:`eyestereo.tools.models.fetch_interpolate.side_word`), bool signals here.
+_FLAGS = ("eof", "eol", "cam", "oor")
 
 
 def _tables():
@@ -37,7 +41,9 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
     """Take coordinate pairs, fetch their 2x2 neighbourhoods, interpolate: one stereo pixel pair per pair.
 
     Two parts with a queue of *side descriptors* between them (one per side of a pair: camera, out of
-    range, request mask, where each kept pixel comes from, the fractions, eol/eof):
+    range, request mask, where each kept pixel comes from, the fractions, eol/eof; the packed word
+    :func:`eyestereo.tools.models.fetch_interpolate.side_word`, in a
+    :func:`~eyestereo.hdl.common.fifo.show_ahead_fifo`):
 
     * the **requester** takes a pair (``coord.read_ack`` high while it is idle), then for the left side and
       then the right: if the side is out of range, queues a black pixel without any request; else compares
@@ -92,9 +98,36 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
     first pixel of a frame comes 9 clocks after its pair is taken.
 
     Resources: 2 multipliers (the weight ``(F+1) x (F+1)`` bits, the weight times the pixel), two
-    small FIFOs (queue ``depth`` x 16..32 bits, pixels 4 x ``depth`` x 8 bits, LUT-RAM), 8 kept pixels and
-    2 tags of the camera image's x/y width.
+    show-ahead FIFOs (queue ``depth`` x 18..32 bits, pixels 4 x ``depth`` x 8 bits, LUT-RAM), 8 kept
+    pixels and 2 tags of the camera image's x/y width.
     """
+    depth = _check(clk, rst, coord, fetch, source, busy, depth)
+    word = model.side_word(coord.frac)
+    side, head = FieldSignals(word, _FLAGS), FieldSignals(word, _FLAGS)  # being requested; at the queue's head
+    side_in, side_out = Signal(intbv(0)[word.width:]), Signal(intbv(0)[word.width:])
+    push, pop = Signal(bool(0)), Signal(bool(0))
+    queued = Signal(intbv(0, min=0, max=depth + 1))
+    pixel, rpop = Signal(intbv(0)[8:]), Signal(bool(0))
+    held = Signal(intbv(0, min=0, max=4 * depth + 1))
+    requesting, running = Signal(bool(0)), Signal(bool(0))
+
+    @always_comb
+    def busy_out():
+        busy.next = requesting or queued != 0 or running
+
+    return (requester(clk, rst, coord, fetch, side, push, queued, requesting, depth=depth),
+            pack_word(side_in, word, **side.fields()),
+            show_ahead_fifo(clk, rst, side_in, push, side_out, pop, queued, depth=depth),
+            unpack_word(side_out, word, **head.fields()),
+            # at most depth sides wait, each for at most 4 pixels: every response fits
+            show_ahead_fifo(clk, rst, fetch.rsp_data, fetch.rsp_valid, pixel, rpop, held, depth=4 * depth),
+            interpolator(clk, rst, head, queued, pixel, held, pop, rpop, source, running, frac=coord.frac),
+            busy_out)
+
+
+def _check(clk, rst, coord, fetch, source, busy, depth) -> int:
+    """The elaboration checks of :func:`fetch_interpolate` (a ValueError naming the port or parameter);
+    returns ``depth``."""
     check_clock(clk)
     check_reset(rst)
     if not isinstance(coord, CoordPair):
@@ -103,13 +136,12 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
     check_stream("source", source, width=8, stereo=True)
     check_signal("busy", busy, width=1)
     depth = check_int("depth", depth, 1, 16)
-    frac = coord.frac
-    if frac > model.MAX_FRAC:
-        raise block_error(f"port coord has frac={frac}; the interpolation takes at most {model.MAX_FRAC} "
-                         f"fraction bits (both products in 18x18 multipliers)")
+    if coord.frac > model.MAX_FRAC:
+        raise block_error(f"port coord has frac={coord.frac}; the interpolation takes at most {model.MAX_FRAC} "
+                          f"fraction bits (both products in 18x18 multipliers)")
     if (fetch.width, fetch.height) != (coord.source_width, coord.source_height):
         raise block_error(f"port fetch is sized for {fetch.width}x{fetch.height} images, port coord for "
-                         f"{coord.source_width}x{coord.source_height}: one camera image size for both")
+                          f"{coord.source_width}x{coord.source_height}: one camera image size for both")
     check_distinct(dict(coord_read_ack=coord.read_ack, fetch_req_valid=fetch.req_valid, fetch_req_x=fetch.req_x,
                         fetch_req_y=fetch.req_y, fetch_req_cam=fetch.req_cam, fetch_req_mask=fetch.req_mask,
                         source=source, busy=busy),
@@ -118,79 +150,162 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
                         coord_oor_r=coord.oor_r, coord_eol=coord.eol, coord_eof=coord.eof,
                         fetch_req_ready=fetch.req_ready, fetch_rsp_valid=fetch.rsp_valid,
                         fetch_rsp_idx=fetch.rsp_idx, fetch_rsp_data=fetch.rsp_data))
+    return depth
 
-    nx, ny = coord.x_format.wl, coord.y_format.wl
-    ix, iy = nx - frac, ny - frac
-    fw = max(frac, 1)
-    S = 1 << frac
-    MASK_T, SRC_T = _tables()
 
-    # ------------------------------------------------------------------ requester
+# ------------------------------------------------------------------ requester
+
+
+@block
+def requester(clk, rst, coord, fetch, side, push, queued, requesting, *, depth: int):
+    """Takes a pair (``read_ack`` while idle), then its left side and its right: ``push`` queues the side
+    (the fields of ``side``) in the clock its request moves, or at once when it needs none; ``requesting``
+    is high from the pair's clock to its right side's push."""
+    frac = coord.frac
+    ix, iy = len(coord.xl) - frac, len(coord.yl) - frac
     IDLE, LEFT, RIGHT = 0, 1, 2
     state = Signal(intbv(0, min=0, max=3))
-    xl, xr = Signal(intbv(0)[nx:]), Signal(intbv(0)[nx:])
-    yl, yr = Signal(intbv(0)[ny:]), Signal(intbv(0)[ny:])
-    oorl, oorr, eol, eof = Signal(bool(0)), Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
-    # tags: the previous in-range neighbourhood of each camera
-    txl, txr = Signal(intbv(0)[ix:]), Signal(intbv(0)[ix:])
-    tyl, tyr = Signal(intbv(0)[iy:]), Signal(intbv(0)[iy:])
-    tvl, tvr = Signal(bool(0)), Signal(bool(0))
-    # the side being requested
-    cam = Signal(bool(0))
-    oor = Signal(bool(0))
+    take, need, space = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
     x0, tx = Signal(intbv(0)[ix:]), Signal(intbv(0)[ix:])
     y0, ty = Signal(intbv(0)[iy:]), Signal(intbv(0)[iy:])
     tv = Signal(bool(0))
-    dx, dy = Signal(intbv(0)[fw:]), Signal(intbv(0)[fw:])
+
+    @always_comb
+    def control():
+        take.next = state == IDLE and coord.valid
+        coord.read_ack.next = state == IDLE
+        requesting.next = state != IDLE
+        side.cam.next = state == RIGHT
+        need.next = not side.oor and side.mask != 0
+        space.next = queued < depth
+
+    @always_comb
+    def request():
+        push.next = state != IDLE and space and (not need or fetch.req_ready)
+        fetch.req_valid.next = state != IDLE and need and space
+        fetch.req_cam.next = side.cam
+        fetch.req_mask.next = side.mask
+        if side.oor:
+            fetch.req_x.next = 0
+            fetch.req_y.next = 0
+        else:
+            fetch.req_x.next = x0
+            fetch.req_y.next = y0
+
+    @always_seq(clk.posedge, reset=rst)
+    def states():
+        if state == IDLE:
+            if coord.valid:
+                state.next = LEFT
+        elif push:
+            if state == LEFT:
+                state.next = RIGHT
+            else:
+                state.next = IDLE
+
+    return (control, request, states, pair_side(clk, rst, coord, take, side, x0, y0),
+            tags(clk, rst, push, side, x0, y0, tx, ty, tv), reuse_rule(x0, y0, tx, ty, tv, side))
+
+
+@block
+def pair_side(clk, rst, coord, take, side, x0, y0):
+    """The pair taken (registers, with its ``eol``/``eof`` as the side's) and, by ``side.cam``, the side's
+    integer position ``x0``, ``y0``, its fractions and its out-of-range flag."""
+    frac = coord.frac
+    nx, ny, fw = len(coord.xl), len(coord.yl), len(side.dx)
+    xl, xr = Signal(intbv(0)[nx:]), Signal(intbv(0)[nx:])
+    yl, yr = Signal(intbv(0)[ny:]), Signal(intbv(0)[ny:])
+    oorl, oorr = Signal(bool(0)), Signal(bool(0))
+
+    @always_seq(clk.posedge, reset=rst)
+    def capture():
+        if take:
+            xl.next = coord.xl
+            yl.next = coord.yl
+            xr.next = coord.xr
+            yr.next = coord.yr
+            oorl.next = coord.oor_l
+            oorr.next = coord.oor_r
+            side.eol.next = coord.eol
+            side.eof.next = coord.eof
+
+    @always_comb
+    def position():
+        if side.cam:
+            side.oor.next = oorr
+            x0.next = xr[nx:frac]
+            y0.next = yr[ny:frac]
+        else:
+            side.oor.next = oorl
+            x0.next = xl[nx:frac]
+            y0.next = yl[ny:frac]
+
+    @always_comb
+    def fractions():
+        if frac == 0:
+            side.dx.next = 0
+            side.dy.next = 0
+        elif side.cam:
+            side.dx.next = xr[fw:0]
+            side.dy.next = yr[fw:0]
+        else:
+            side.dx.next = xl[fw:0]
+            side.dy.next = yl[fw:0]
+
+    return capture, position, fractions
+
+
+@block
+def tags(clk, rst, push, side, x0, y0, tx, ty, tv):
+    """Per camera the tag of its kept neighbourhood (the position of its last in-range side, valid bit
+    ``tv``), ``side.cam``'s on ``tx``, ``ty``, ``tv``; emptied after a pair with ``eof`` (the frame
+    buffers change)."""
+    txl, txr = Signal(intbv(0)[len(x0):]), Signal(intbv(0)[len(x0):])
+    tyl, tyr = Signal(intbv(0)[len(y0):]), Signal(intbv(0)[len(y0):])
+    tvl, tvr = Signal(bool(0)), Signal(bool(0))
+
+    @always_comb
+    def select():
+        if side.cam:
+            tx.next = txr
+            ty.next = tyr
+            tv.next = tvr
+        else:
+            tx.next = txl
+            ty.next = tyl
+            tv.next = tvl
+
+    @always_seq(clk.posedge, reset=rst)
+    def update():
+        if push:
+            if not side.cam:
+                if not side.oor:
+                    txl.next = x0
+                    tyl.next = y0
+                    tvl.next = 1
+            else:
+                if not side.oor:
+                    txr.next = x0
+                    tyr.next = y0
+                    tvr.next = 1
+                if side.eof:
+                    tvl.next = 0
+                    tvr.next = 0
+
+    return select, update
+
+
+@block
+def reuse_rule(x0, y0, tx, ty, tv, side):
+    """The reuse rule (:func:`_tables`): from the side's position and its camera's tag, the request
+    ``side.mask`` and where each kept pixel comes from, ``side.src``."""
+    ix, iy = len(x0), len(y0)
+    MASK_T, SRC_T = _tables()
     XOFF, YOFF = (1 << (ix + 1)) + 1, (1 << (iy + 1)) + 1
     ex, ey = Signal(intbv(0)[ix + 2:]), Signal(intbv(0)[iy + 2:])
     exl, eyl = Signal(intbv(0)[ix + 1:]), Signal(intbv(0)[iy + 1:])
     cx, cy = Signal(intbv(0)[2:]), Signal(intbv(0)[2:])
     code = Signal(intbv(0)[4:])
-    rom_mask = Signal(intbv(0)[4:])
-    rom_src = Signal(intbv(0)[8:])
-    mask = Signal(intbv(0)[4:])
-    need = Signal(bool(0))
-    space = Signal(bool(0))
-    advance = Signal(bool(0))
-    # the side queue
-    DW = 2 * fw + 16
-    dword = Signal(intbv(0)[DW:])
-    dmem = [Signal(intbv(0)[DW:]) for _ in range(depth)]
-    dwp, drp = Signal(intbv(0, min=0, max=depth)), Signal(intbv(0, min=0, max=depth))
-    dcount = Signal(intbv(0, min=0, max=depth + 1))
-    pop = Signal(bool(0))
-
-    @always_comb
-    def side():
-        if state == RIGHT:
-            cam.next = 1
-            oor.next = oorr
-            x0.next = xr[nx:frac]
-            y0.next = yr[ny:frac]
-            tx.next = txr
-            ty.next = tyr
-            tv.next = tvr
-        else:
-            cam.next = 0
-            oor.next = oorl
-            x0.next = xl[nx:frac]
-            y0.next = yl[ny:frac]
-            tx.next = txl
-            ty.next = tyl
-            tv.next = tvl
-
-    @always_comb
-    def fractions():
-        if frac == 0:
-            dx.next = 0
-            dy.next = 0
-        elif state == RIGHT:
-            dx.next = xr[fw:0]
-            dy.next = yr[fw:0]
-        else:
-            dx.next = xl[fw:0]
-            dy.next = yl[fw:0]
 
     @always_comb
     def offsets():
@@ -206,7 +321,7 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
         eyl.next = ey[iy + 1:0]
 
     @always_comb
-    def reuse_code():
+    def steps():
         # 3 = no reuse (the low ix+1 bits are 0..2 only for ddx = -1..1)
         if exl < 3:
             cx.next = exl[2:0]
@@ -218,7 +333,7 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
             cy.next = 3
 
     @always_comb
-    def reuse_code2():
+    def table_index():
         if tv:
             code.next = concat(cy, cx)
         else:
@@ -226,224 +341,150 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
 
     @always_comb
     def mask_rom():
-        rom_mask.next = MASK_T[code]
+        side.mask.next = MASK_T[code]
 
     @always_comb
     def src_rom():
-        rom_src.next = SRC_T[code]
+        side.src.next = SRC_T[code]
 
-    @always_comb
-    def request():
-        mask.next = rom_mask
-        need.next = not oor and rom_mask != 0
-        space.next = dcount < depth
-        dword.next = concat(dy, dx, rom_src, rom_mask, oor, cam, eol, eof)
+    return offsets, offsets_low, steps, table_index, mask_rom, src_rom
 
-    @always_comb
-    def request2():
-        advance.next = state != IDLE and space and (not need or fetch.req_ready)
-        fetch.req_valid.next = state != IDLE and need and space
-        coord.read_ack.next = state == IDLE
-        fetch.req_cam.next = cam
-        fetch.req_mask.next = mask
-        if oor:
-            fetch.req_x.next = 0
-            fetch.req_y.next = 0
-        else:
-            fetch.req_x.next = x0
-            fetch.req_y.next = y0
 
-    @always_seq(clk.posedge, reset=rst)
-    def requester():
-        if state == IDLE:
-            if coord.valid:
-                xl.next = coord.xl
-                yl.next = coord.yl
-                xr.next = coord.xr
-                yr.next = coord.yr
-                oorl.next = coord.oor_l
-                oorr.next = coord.oor_r
-                eol.next = coord.eol
-                eof.next = coord.eof
-                state.next = LEFT
-        elif advance:
-            if dwp == depth - 1:
-                dwp.next = 0
-            else:
-                dwp.next = dwp + 1
-            if state == LEFT:
-                if not oor:
-                    txl.next = x0
-                    tyl.next = y0
-                    tvl.next = 1
-                state.next = RIGHT
-            else:
-                if not oor:
-                    txr.next = x0
-                    tyr.next = y0
-                    tvr.next = 1
-                state.next = IDLE
-                if eof:  # a new frame follows: the frame buffers change
-                    tvl.next = 0
-                    tvr.next = 0
-        if advance and not pop:
-            dcount.next = dcount + 1
-        elif pop and not advance:
-            dcount.next = dcount - 1
+# ------------------------------------------------------------------ interpolator
 
-    @always_seq(clk.posedge, reset=None)
-    def queue_mem():
-        if state != IDLE and advance:
-            dmem[dwp].next = dword
 
-    # ------------------------------------------------------------------ response FIFO
-    RD = 4 * depth
-    rmem = [Signal(intbv(0)[8:]) for _ in range(RD)]
-    rwp, rrp = Signal(intbv(0, min=0, max=RD)), Signal(intbv(0, min=0, max=RD))
-    rcount = Signal(intbv(0, min=0, max=RD + 1))
-    rhead = Signal(intbv(0)[8:])
-    rpop = Signal(bool(0))
-
-    @always_seq(clk.posedge, reset=None)
-    def rfifo_mem():
-        if fetch.rsp_valid:
-            rmem[rwp].next = fetch.rsp_data
-
-    @always_seq(clk.posedge, reset=rst)
-    def rfifo():
-        if fetch.rsp_valid:
-            if rwp == RD - 1:
-                rwp.next = 0
-            else:
-                rwp.next = rwp + 1
-        if rpop:
-            if rrp == RD - 1:
-                rrp.next = 0
-            else:
-                rrp.next = rrp + 1
-        if fetch.rsp_valid and not rpop:
-            rcount.next = rcount + 1
-        elif rpop and not fetch.rsp_valid:
-            rcount.next = rcount - 1
-
-    @always_comb
-    def rfifo_head():
-        rhead.next = rmem[rrp]
-
-    # ------------------------------------------------------------------ interpolator
-    head = Signal(intbv(0)[DW:])
-    h_eof, h_eol, h_cam, h_oor = Signal(bool(0)), Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
-    h_mask = Signal(intbv(0)[4:])
-    h_src = Signal(intbv(0)[8:])
-    h_dx, h_dy = Signal(intbv(0)[fw:]), Signal(intbv(0)[fw:])
+@block
+def interpolator(clk, rst, head, queued, pixel, held, pop, rpop, source, running, *, frac: int):
+    """Four multiply-accumulate steps per queued side, one for a black side (module docstring): ``pop``
+    with the side's last step, ``rpop`` with each step whose pixel comes from the response FIFO."""
     step = Signal(intbv(0, min=0, max=4))
     fetched = Signal(bool(0))  # the step's pixel comes from the response FIFO
-    fire = Signal(bool(0))
-    last = Signal(bool(0))
-    src_i = Signal(intbv(0)[2:])
-    kept = [Signal(intbv(0)[8:]) for _ in range(8)]  # kept[4 * cam + index]
-    kidx = Signal(intbv(0, min=0, max=8))
-    kpix = Signal(intbv(0)[8:])
-    pix = Signal(intbv(0)[8:])
-    nbuf = [Signal(intbv(0)[8:]) for _ in range(3)]
-    wa, wb = Signal(intbv(0)[frac + 1:]), Signal(intbv(0)[frac + 1:])
+    fire, last = Signal(bool(0)), Signal(bool(0))
+    pix, kpix = Signal(intbv(0)[8:]), Signal(intbv(0)[8:])
     weight = Signal(intbv(0)[2 * frac + 2:])
-    # stage 1 (the weight and the pixel), stage 2 (the accumulator)
-    v1, first1, last1 = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
-    w1 = Signal(intbv(0)[2 * frac + 2:])
-    p1 = Signal(intbv(0)[8:])
-    t1 = Signal(intbv(0)[3:])  # cam, eol, eof
-    ACC = 8 + 2 * frac + 1
-    acc = Signal(intbv(0)[ACC:])
-    v2 = Signal(bool(0))
-    t2 = Signal(intbv(0)[3:])
-    rounded = Signal(intbv(0)[ACC + 1:])
-    HALF = (1 << (2 * frac)) >> 1
 
     @always_comb
-    def unpack():
-        head.next = dmem[drp]
+    def step_fire():
+        fetched.next = not head.oor and head.mask[step]
+        fire.next = queued != 0 and (not fetched or held != 0)
+        last.next = head.oor or step == 3
+        rpop.next = queued != 0 and fetched and held != 0
+        pop.next = queued != 0 and (not fetched or held != 0) and (head.oor or step == 3)
+        pix.next = pixel if fetched else kpix
+
+    @always_seq(clk.posedge, reset=rst)
+    def steps():
+        if fire:
+            if last:
+                step.next = 0
+            else:
+                step.next = step + 1
+
+    return (step_fire, steps, kept_pixels(clk, fire, head, step, pix, kpix), step_weight(step, head, weight, frac=frac),
+            mac(clk, rst, fire, last, step, head, weight, pix, source, running, frac=frac))
+
+
+@block
+def kept_pixels(clk, fire, head, step, pix, kpix):
+    """Per camera the four pixels of its last in-range side (``kept[4 * cam + index]``), and ``kpix``: the
+    one the current step reuses (index ``head.src`` names for it)."""
+    kept = [Signal(intbv(0)[8:]) for _ in range(8)]
+    taken = [Signal(intbv(0)[8:]) for _ in range(3)]  # the side's pixels 0..2 until its step 3
+    src_i = Signal(intbv(0)[2:])
+    kidx = Signal(intbv(0, min=0, max=8))
 
     @always_comb
-    def unpack2():
-        h_eof.next = head[0]
-        h_eol.next = head[1]
-        h_cam.next = head[2]
-        h_oor.next = head[3]
-        h_mask.next = head[8:4]
-        h_src.next = head[16:8]
-        h_dx.next = head[16 + fw:16]
-        h_dy.next = head[16 + 2 * fw:16 + fw]
-
-    @always_comb
-    def step_select():
-        fetched.next = not h_oor and h_mask[step]
+    def source_index():
         if step == 0:
-            src_i.next = h_src[2:0]
+            src_i.next = head.src[2:0]
         elif step == 1:
-            src_i.next = h_src[4:2]
+            src_i.next = head.src[4:2]
         elif step == 2:
-            src_i.next = h_src[6:4]
+            src_i.next = head.src[6:4]
         else:
-            src_i.next = h_src[8:6]
+            src_i.next = head.src[8:6]
 
     @always_comb
     def kept_index():
-        kidx.next = concat(h_cam, src_i)
+        kidx.next = concat(head.cam, src_i)
 
     @always_comb
     def kept_read():
         kpix.next = kept[kidx]
 
-    @always_comb
-    def step_fire():
-        fire.next = dcount != 0 and (not fetched or rcount != 0)
-        last.next = h_oor or step == 3
-        rpop.next = dcount != 0 and fetched and rcount != 0
-        pop.next = dcount != 0 and (not fetched or rcount != 0) and (h_oor or step == 3)
-        if fetched:
-            pix.next = rhead
-        else:
-            pix.next = kpix
+    @always(clk.posedge)
+    def keep():
+        # the side's pixels become its camera's kept neighbourhood (in-range sides only)
+        if fire and not head.oor:
+            for i in range(3):
+                if step == i:
+                    taken[i].next = pix
+            if step == 3 and head.cam:
+                kept[4].next = taken[0]
+                kept[5].next = taken[1]
+                kept[6].next = taken[2]
+                kept[7].next = pix
+            elif step == 3:
+                kept[0].next = taken[0]
+                kept[1].next = taken[1]
+                kept[2].next = taken[2]
+                kept[3].next = pix
+
+    return source_index, kept_index, kept_read, keep
+
+
+@block
+def step_weight(step, head, weight, *, frac: int):
+    """The step's weight: index 0 ``dx*dy``, 1 ``(S-dx)*dy``, 2 ``dx*(S-dy)``, 3 ``(S-dx)*(S-dy)``
+    (S = 2**frac), the first multiplier."""
+    S = 1 << frac
+    wa, wb = Signal(intbv(0)[frac + 1:]), Signal(intbv(0)[frac + 1:])
 
     @always_comb
-    def weights():
-        # index 0 dx*dy, 1 (S-dx)*dy, 2 dx*(S-dy), 3 (S-dx)*(S-dy)
+    def factors():
         if step == 0 or step == 2:
-            wa.next = h_dx
+            wa.next = head.dx
         else:
-            wa.next = S - h_dx
+            wa.next = S - head.dx
         if step == 0 or step == 1:
-            wb.next = h_dy
+            wb.next = head.dy
         else:
-            wb.next = S - h_dy
+            wb.next = S - head.dy
 
     @always_comb
-    def multiply_weight():
+    def multiply():
         weight.next = wa * wb
 
+    return factors, multiply
+
+
+@block
+def mac(clk, rst, fire, last, step, head, weight, pix, source, running, *, frac: int):
+    """Stage 1 registers the step's weight and pixel (0 for a black side), stage 2 accumulates
+    ``acc += w * p`` (the second multiplier; restarting at index 0), the output register takes
+    ``(acc + S*S/2) >> 2*frac`` after a side's last step; ``running`` while a step is in the stages."""
+    v1, first1, last1, v2 = Signal(bool(0)), Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
+    w1 = Signal(intbv(0)[2 * frac + 2:])
+    p1 = Signal(intbv(0)[8:])
+    t1, t2 = Signal(intbv(0)[3:]), Signal(intbv(0)[3:])  # cam, eol, eof
+    ACC = 8 + 2 * frac + 1
+    acc = Signal(intbv(0)[ACC:])
+    rounded = Signal(intbv(0)[ACC + 1:])
+    HALF = (1 << (2 * frac)) >> 1
+
     @always_seq(clk.posedge, reset=rst)
-    def interpolator():
+    def stages():
         v1.next = fire
         if fire:
             first1.next = step == 0
             last1.next = last
-            t1.next = concat(h_cam, h_eol, h_eof)
-            if h_oor:
+            t1.next = concat(head.cam, head.eol, head.eof)
+            if head.oor:
                 w1.next = 0
                 p1.next = 0
             else:
                 w1.next = weight
                 p1.next = pix
-            if last:
-                step.next = 0
-                if drp == depth - 1:
-                    drp.next = 0
-                else:
-                    drp.next = drp + 1
-            else:
-                step.next = step + 1
-        # stage 2: multiply-accumulate
         v2.next = v1 and last1
         if v1:
             t2.next = t1
@@ -451,7 +492,6 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
                 acc.next = w1 * p1
             else:
                 acc.next = acc + w1 * p1
-        # output register
         source.valid.next = v2
         if v2:
             source.data.next = rounded[ACC:2 * frac]
@@ -459,36 +499,12 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
             source.eol.next = t2[1]
             source.eof.next = t2[0]
 
-    @always_seq(clk.posedge, reset=None)
-    def keep():
-        # the side's pixels become its camera's kept neighbourhood (in-range sides only)
-        if fire and not h_oor:
-            if step == 0:
-                nbuf[0].next = pix
-            elif step == 1:
-                nbuf[1].next = pix
-            elif step == 2:
-                nbuf[2].next = pix
-            else:
-                if h_cam:
-                    kept[4].next = nbuf[0]
-                    kept[5].next = nbuf[1]
-                    kept[6].next = nbuf[2]
-                    kept[7].next = pix
-                else:
-                    kept[0].next = nbuf[0]
-                    kept[1].next = nbuf[1]
-                    kept[2].next = nbuf[2]
-                    kept[3].next = pix
-
     @always_comb
     def rounding():
         rounded.next = acc + HALF
 
     @always_comb
-    def busy_out():
-        busy.next = state != IDLE or dcount != 0 or v1 or v2
+    def running_out():
+        running.next = v1 or v2
 
-    return (side, fractions, offsets, offsets_low, reuse_code, reuse_code2, mask_rom, src_rom, request, request2, requester, queue_mem,
-            rfifo_mem, rfifo, rfifo_head, unpack, unpack2, step_select, kept_index, kept_read, step_fire,
-            weights, multiply_weight, interpolator, keep, rounding, busy_out)
+    return stages, rounding, running_out

@@ -2,22 +2,18 @@
 
 from __future__ import annotations
 
-import os
-from typing import Any
-
 from myhdl import Signal, always, always_comb, always_seq, block, intbv
 
-from eyestereo.hdl.common.checks import (block_error, check_clock, check_distinct, check_int, check_reset,
-                                         check_signal)
+from eyestereo.hdl.common.checks import block_error, check_clock, check_distinct, check_int, check_reset, check_signal
 from eyestereo.hdl.common.quantize import fmt_signal, fx_add, fx_mul, fx_resize
 from eyestereo.hdl.common.registers import assign
+from eyestereo.hdl.rectify.calibration import calibration_param
 from eyestereo.tools.fixed import Fmt, ufix
 from eyestereo.tools.models import poly_unit as model
-from eyestereo.tools.rectify.ffc import FFCError
 
 LATENCY = model.LATENCY
 
-__all__ = ["LATENCY", "CoefPort", "calibration_param", "poly_unit"]
+__all__ = ["LATENCY", "CoefPort", "poly_unit"]
 
 
 class CoefPort:
@@ -44,35 +40,6 @@ class CoefPort:
 
     def fields(self) -> list[str]:
         return ["we", "addr", "data"]
-
-
-def calibration_param(quantizers: Any, source_width: Any, source_height: Any) -> model.Calibration:
-    """The ``quantizers`` parameter (a :class:`~eyestereo.tools.models.poly_unit.Calibration`, a spec of
-    :func:`eyestereo.tools.rectify.calibrations.load`, a path or a document) as a checked calibration."""
-    sw = None if source_width is None else check_int("source_width", source_width, 2, 65536)
-    sh = None if source_height is None else check_int("source_height", source_height, 2, 65536)
-    if isinstance(quantizers, model.Calibration):
-        cal = quantizers
-        if sw is not None or sh is not None:
-            cal = model.Calibration(cal.width, cal.height, sw or cal.source_width, sh or cal.source_height,
-                                    cal.formats, cal.codes, cal.origin)
-    else:
-        if quantizers is not None and not isinstance(quantizers, (str, os.PathLike, dict)):
-            raise block_error(f"parameter quantizers must be a calibration spec, a quantizers.json path or "
-                             f"document, or a Calibration; got {type(quantizers).__name__}")
-        try:
-            cal = model.Calibration.load(quantizers, source_width=sw, source_height=sh)
-        except (FFCError, ValueError, FileNotFoundError, KeyError) as exc:
-            raise block_error(f"parameter quantizers: {exc}") from None
-    if cal.source_width < 2 or cal.source_height < 2:
-        raise block_error(f"parameter source_width/source_height: the camera image must be at least 2x2 "
-                         f"pixels, got {cal.source_width}x{cal.source_height}")
-    for i, f in enumerate(cal.formats[:10], 1):
-        if f.wl > 31:
-            raise block_error(f"parameter quantizers: q{i} {f} is wider than 31 bits (VHDL integer constants)")
-    if cal.out_format.wl > 31:
-        raise block_error(f"parameter quantizers: q24 {cal.out_format} is wider than 31 bits")
-    return cal
 
 
 @block
@@ -264,7 +231,7 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
         else:
             insts.append(coef_ram(clk, idx[where], cbits[i], coef, i - 1, codes))
     c1, c2, c3, c4, c5, c6, c7, c8, c9, c10 = (creg[i] for i in range(1, 11))
-    b1, b2, b3, b4, b5, b6, b7, b8, b9, b10 = (cbits[i] for i in range(1, 11))
+    b1, b2, _, _, _, b6, b7, b8, b9, b10 = (cbits[i] for i in range(1, 11))  # b3..b5 feed no shift-add
 
     # --- stage A inputs: the counters quantized by q25 / q26
     xq, yq = fmt_signal(q(25)), fmt_signal(q(26))

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 from myhdl import Signal, always_comb, block
 
-from eyestereo.hdl.common.checks import block_error, check_clock, check_distinct, check_int, check_reset, \
-    check_signal, check_stream
+from eyestereo.hdl.common.checks import (block_error, check_clock, check_distinct, check_int, check_reset,
+                                         check_signal, check_stream)
 from eyestereo.hdl.interfaces.coord_pair import CoordPair
+from eyestereo.hdl.interfaces.fetch_port import check_fetch
+from eyestereo.hdl.rectify.calibration import calibration_param
 from eyestereo.hdl.rectify.coordinate_warper import FIRST_PAIR, coordinate_warper
 from eyestereo.hdl.rectify.fetch_interpolate import DEFAULT_DEPTH, fetch_interpolate
-from eyestereo.hdl.interfaces.fetch_port import check_fetch
-from eyestereo.hdl.rectify.poly_unit import calibration_param
 from eyestereo.tools.models import fetch_interpolate as fi_model
 from eyestereo.tools.models import poly_unit as unit_model
 

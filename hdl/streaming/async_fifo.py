@@ -53,7 +53,8 @@ def async_fifo(wclk, wrst, sink, rclk, rrst, source, dropped, full=None, empty=N
     (they start at 0 with the FPGA's configuration, their initial values), so neither side ever sees the
     other's pointer jump. ``wrst`` abandons the frame the write side was taking in (counted as dropped,
     a token follows its words if any are in the FIFO); the sink's producer must share that reset, so that
-    its next beat after the reset starts a frame (camera_stream does, in camera_interface). ``rrst`` discards the word in the output register;
+    its next beat after the reset starts a frame (camera_stream does, in camera_interface). ``rrst`` discards
+    the word in the output register;
     if the reader was inside a frame, the read side then loads and discards entries up to the end of that
     frame (or its token), so the next word presented is the first of a frame.
 

@@ -3,16 +3,18 @@
 import numpy as np
 from myhdl import Signal, always, always_comb, block, intbv
 
-from eyestereo.hdl.common import range_signal, signal_range, column_taps, delay, en_reg, shift_add, window_control
-from eyestereo.hdl.common.fixed import fx_signal
+from eyestereo.hdl.common import delay, en_reg, range_signal, shift_add, signal_range
 from eyestereo.hdl.common.checks import (block_error, check_clock, check_distinct, check_frame, check_int,
                                          check_reset, check_stream, checked)
+from eyestereo.hdl.common.fixed import fx_signal
+from eyestereo.hdl.streaming.window import column_taps, window_control, window_row
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 from eyestereo.tools.models.convolve import check_kernel, output_format
 
 
 @block
 def convolve(clk, rst, sink, source, *, kernel=None, col=None, row=None, shift: int = 0,
-             width: int = 352, height: int = 288):
+             width: int = FRAME_WIDTH, height: int = FRAME_HEIGHT):
     """``source`` pixel (x, y) = floor(sum k[i, j] * p(x - r + j, y - r + i) / 2**shift), r = N // 2.
 
     The window is centred on the output pixel (correlation, no kernel flip). Give ``kernel`` (NxN) for
@@ -70,21 +72,17 @@ def convolve(clk, rst, sink, source, *, kernel=None, col=None, row=None, shift: 
         vvalid = Signal(bool(0))
         insts += [shift_add(list(zip(taps, cv)), vsum), delay(clk, vsum, vreg, clocks=1),
                   delay(clk, tap_valid, vvalid, clocks=1)]
-        hregs = [range_signal(vlo, vhi) for _ in range(n)]  # hregs[0] newest = rightmost column
-        src = vreg
-        for h in hregs:
+        links, hregs = window_row(vreg, n, stereo=False)  # hregs[0] newest = rightmost column
+        for src, h in links:
             insts.append(en_reg(clk, vvalid, src, h))
-            src = h
         total = _sum_sig(hregs, rv[::-1])
         insts.append(shift_add(list(zip(hregs, rv[::-1])), total))
     else:
         rowsums = []
         for i in range(n):
-            w = [Signal(intbv(0)[dw:]) for _ in range(n)]  # w[0] newest = rightmost column
-            src = taps[i]
-            for reg in w:
+            links, w = window_row(taps[i], n, stereo=False)  # w[0] newest = rightmost column
+            for src, reg in links:
                 insts.append(en_reg(clk, tap_valid, src, reg))
-                src = reg
             coeffs = [int(c) for c in k[i][::-1]]
             rs = _sum_sig(w, coeffs)
             rreg = range_signal(*signal_range(rs))

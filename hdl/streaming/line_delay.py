@@ -50,53 +50,34 @@ def line_delay(clk, rst, sink, source, *, width: int = 352, height: int = 288):
     check_distinct(dict(source=source), dict(clk=clk, rst=rst, sink=sink))
     width, height = check_frame(width, height)
 
-    if sink.stereo:
-        return stereo_line_delay(clk, rst, sink, source, width=width)
-
-    mem = [Signal(intbv(0)[dw:]) for _ in range(width)]
+    stereo = sink.stereo
+    depth = 2 * width if stereo else width
+    mem = [Signal(intbv(0)[dw:]) for _ in range(depth)]
     col = Signal(intbv(0, min=0, max=width))
+    addr = Signal(intbv(0, min=0, max=depth))
+    step = Signal(bool(0))  # the column moves on (or is cleared) this clock
     pixel = Signal(bool(0))  # a valid beat that is not a reset token
+
+    # The one difference between the kinds: the address and the beat that moves the column on.
+    if stereo:
+        @always_comb
+        def address():
+            addr.next = concat(col, sink.cam)
+            # the column moves on with the right camera's beat; a reset token (either cam) clears it
+            step.next = sink.valid and (sink.cam or (sink.eof and not sink.eol))
+
+        @always_seq(clk.posedge, reset=rst)
+        def camera():
+            source.cam.next = sink.cam
+    else:
+        @always_comb
+        def address():
+            addr.next = col
+            step.next = sink.valid
 
     @always(clk.posedge)
     def ram():
         # No reset here: a memory with a reset cannot be mapped to block RAM.
-        if pixel:
-            mem[col].next = sink.data
-            source.data.next = mem[col]
-
-    @always_seq(clk.posedge, reset=rst)
-    def control():
-        source.valid.next = sink.valid
-        source.eol.next = sink.eol
-        source.eof.next = sink.eof
-        if sink.valid:
-            if sink.eof or col == width - 1:
-                col.next = 0
-            else:
-                col.next = col + 1
-
-    @always(sink.valid, sink.eol, sink.eof)
-    def decode():
-        pixel.next = sink.valid and (sink.eol or not sink.eof)
-
-    return ram, control, decode
-
-
-@block
-def stereo_line_delay(clk, rst, sink, source, *, width: int):
-    """:func:`line_delay` for stereo streams: one memory of 2 x width words, addressed by (column, cam)."""
-    dw = sink.data_width
-    mem = [Signal(intbv(0)[dw:]) for _ in range(2 * width)]
-    col = Signal(intbv(0, min=0, max=width))
-    addr = Signal(intbv(0, min=0, max=2 * width))
-    pixel = Signal(bool(0))
-
-    @always_comb
-    def address():
-        addr.next = concat(col, sink.cam)
-
-    @always(clk.posedge)
-    def ram():
         if pixel:
             mem[addr].next = sink.data
             source.data.next = mem[addr]
@@ -106,9 +87,7 @@ def stereo_line_delay(clk, rst, sink, source, *, width: int):
         source.valid.next = sink.valid
         source.eol.next = sink.eol
         source.eof.next = sink.eof
-        source.cam.next = sink.cam
-        # The column moves on with the right camera's beat; a reset token (either cam) clears it.
-        if sink.valid and (sink.cam or (sink.eof and not sink.eol)):
+        if step:
             if sink.eof or col == width - 1:
                 col.next = 0
             else:
@@ -118,4 +97,6 @@ def stereo_line_delay(clk, rst, sink, source, *, width: int):
     def decode():
         pixel.next = sink.valid and (sink.eol or not sink.eof)
 
+    if stereo:
+        return address, camera, ram, control, decode
     return address, ram, control, decode

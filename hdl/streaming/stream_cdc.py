@@ -65,19 +65,13 @@ def stream_cdc(wclk, wrst, sink, rclk, rrst, source, dropped, *, depth: int = 16
     depth = check_depth(depth)
     dw = sink.data_width
     fw = fifo_width(dw, sink.stereo)
-    fin = ImageStream(fw)
+    # A mono stream is the FIFO's own word (data, eol, eof): it goes in unchanged.
+    fin = ImageStream(fw) if sink.stereo else sink
     q = QueuePort(fw)
     q.ready = Signal(bool(1))  # never driven: the reader takes every word (no back-pressure downstream)
     fifo = async_fifo(wclk, wrst, fin, rclk, rrst, q, dropped, depth=depth)
 
     if not sink.stereo:
-        @always_comb
-        def w_side():
-            fin.valid.next = sink.valid
-            fin.data.next = sink.data
-            fin.eol.next = sink.eol
-            fin.eof.next = sink.eof
-
         @always_comb
         def r_side():
             source.valid.next = q.valid
@@ -85,7 +79,7 @@ def stream_cdc(wclk, wrst, sink, rclk, rrst, source, dropped, *, depth: int = 16
             source.eol.next = q.eol
             source.eof.next = q.eof
 
-        return fifo, w_side, r_side
+        return fifo, r_side
 
     @always_comb
     def w_side():

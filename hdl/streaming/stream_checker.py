@@ -4,13 +4,14 @@ from myhdl import Signal, always, always_comb, always_seq, block, intbv
 
 from eyestereo.hdl.common.checks import (check_bool, check_clock, check_distinct, check_frame, check_reset,
                                          check_signal, check_stream)
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 from eyestereo.tools.models import stream_checker as model
 
 LATENCY = 1
 
 
 @block
-def stream_checker(clk, rst, sink, source, error, code, *, width: int = 352, height: int = 288,
+def stream_checker(clk, rst, sink, source, error, code, *, width: int = FRAME_WIDTH, height: int = FRAME_HEIGHT,
                    repair: bool = False):
     """Check that ``sink`` keeps the image-stream protocol for ``width`` x ``height`` frames; pass it on.
 
@@ -184,7 +185,10 @@ def stream_checker(clk, rst, sink, source, error, code, *, width: int = 352, hei
 
     @always_seq(clk.posedge, reset=rst)
     def position():
-        if token:
+        # token, advance and bad exclude each other (a token is no pixel beat; ok and bad are opposites), and
+        # an end-of-frame beat is a pixel beat: not ok, it is bad.
+        if token or (frame_end and not ok):
+            # A reset token or a broken frame's last beat: the next beat begins a frame, in sync again.
             x.next = 0
             y.next = 0
             x_last.next = x_last_0
@@ -204,14 +208,7 @@ def stream_checker(clk, rst, sink, source, error, code, *, width: int = 352, hei
                 x.next = x + 1
                 x_last.next = x == xl - 1
         elif bad:
-            if frame_end:
-                x.next = 0
-                y.next = 0
-                x_last.next = x_last_0
-                y_last.next = y_last_0
-                sync.next = True
-            else:
-                sync.next = False
+            sync.next = False
 
     @always_seq(clk.posedge, reset=rst)
     def flag():
@@ -255,21 +252,18 @@ def geometry(sink, x_last, y_last, fault):
 
     @always_comb
     def classify():
+        # No fault unless a flag comes where the position does not end a line (frame), or fails to come
+        # where it does.
+        fault.next = 0
         if not x_last:
             if sink.eol:
                 fault.next = SHORT
-            else:
-                fault.next = 0
         elif not sink.eol:
             fault.next = LONG
         elif not y_last:
             if sink.eof:
                 fault.next = EARLY
-            else:
-                fault.next = 0
         elif not sink.eof:
             fault.next = NOEOF
-        else:
-            fault.next = 0
 
     return classify

@@ -1,1 +1,1 @@
-"""The complete front end: stereo_frontend, its sequencer and the register bank."""
+"""The complete front end: stereo_frontend, its sequencer, the register bank and its frame-handshake wiring."""

@@ -5,9 +5,11 @@ from __future__ import annotations
 from myhdl import ConcatSignal, Signal, always, always_comb, always_seq, block, enum, intbv
 from myhdl._Signal import _Signal
 
-from eyestereo.hdl.interfaces.axil import AxiLite, check_axil
+from eyestereo.hdl.interfaces.axil import check_axil
 from eyestereo.hdl.common.checks import block_error, check_clock, check_reset, checked
+from eyestereo.hdl.common.registers import assign
 from eyestereo.hdl.interfaces.sram_bus import HostPort, StatPort, check_bundle
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 from eyestereo.tools.regmap import OKAY, REGMAP, SLVERR, WRITABLE, Register, RegisterMap, check_frame_size
 
 __all__ = ["RegisterPorts", "register_bank", "read_wait", "WINDOW_PORTS"]
@@ -66,9 +68,10 @@ def read_wait(regmap: RegisterMap = REGMAP) -> int:
 
 # ---- small blocks the bank is built of (each of fixed shape, so that the whole converts) -----------------
 @block
-def rb_hit(clk, rst, waddr, in_local, hit, *, base: int, lo: int, hi: int, count: int):
+def rb_hit(clk, rst, waddr, in_local, wr_now, hit, we, *, base: int, lo: int, hi: int, count: int):
     """hit (registered): the word address lies in a register's region ``waddr[hi:lo] == base`` (and its
-    index ``waddr[lo:0] < count`` where the region is larger than the register)."""
+    index ``waddr[lo:0] < count`` where the region is larger than the register); we (a writable register's,
+    None for the others): hit in the clock the bank writes (``wr_now``)."""
     full = count == 1 << lo
 
     if full:
@@ -80,7 +83,14 @@ def rb_hit(clk, rst, waddr, in_local, hit, *, base: int, lo: int, hi: int, count
         def match():
             hit.next = in_local and waddr[hi:lo] == base and waddr[lo:0] < count
 
-    return match
+    if we is None:
+        return match
+
+    @always_comb
+    def write():
+        we.next = wr_now and hit
+
+    return match, write
 
 
 @block
@@ -227,15 +237,6 @@ def rb_any(bits, out):
     return comb
 
 
-@block
-def rb_copy(a, b):
-    @always_comb
-    def comb():
-        b.next = a
-
-    return comb
-
-
 def _pack(r: Register, sigs: dict):
     """A register's read word from its fields' signals: ConcatSignal with zeros in the gaps."""
     parts, top = [], 32
@@ -264,7 +265,7 @@ def _check_ports(regs: RegisterPorts, regmap: RegisterMap) -> None:
 
 
 @block
-def register_bank(clk, rst, bus, regs, arb, fcount, host, *, width: int = 352, height: int = 288):
+def register_bank(clk, rst, bus, regs, arb, fcount, host, *, width: int = FRAME_WIDTH, height: int = FRAME_HEIGHT):
     """The register map (:data:`eyestereo.tools.regmap.REGMAP`, docs/registers.md) on an AXI4-Lite slave.
 
     Everything is elaborated from the table: one output port per ``rw`` and ``pulse`` field, one input
@@ -336,6 +337,8 @@ def register_bank(clk, rst, bus, regs, arb, fcount, host, *, width: int = 352, h
     in_local = Signal(bool(0))
     mem_sel = Signal(bool(0))
     wr_now = Signal(bool(0))
+    # the fsm's registers behind the bus and host outputs, copied to the ports below (signals of their own:
+    # they hold 0, not 'U', before the first reset, when the bus model already samples them)
     awready, wready, arready = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
     bvalid, rvalid = Signal(bool(0)), Signal(bool(0))
     bresp, rresp = Signal(intbv(0)[2:]), Signal(intbv(0)[2:])
@@ -348,13 +351,13 @@ def register_bank(clk, rst, bus, regs, arb, fcount, host, *, width: int = 352, h
         if r.kind == "memory":
             continue
         hit = Signal(bool(0))
+        we = Signal(bool(0)) if r.kind in WRITABLE else None
         lo = (r.span // 4 - 1).bit_length()
-        insts.append(rb_hit(clk, rst, waddr, in_local, hit, base=(r.offset // 4) >> lo, lo=lo, hi=LB, count=r.count))
+        insts.append(rb_hit(clk, rst, waddr, in_local, wr_now, hit, we, base=(r.offset // 4) >> lo, lo=lo, hi=LB,
+                            count=r.count))
         hits.append(hit)
-        we = Signal(bool(0))
-        if r.kind in WRITABLE:
+        if we is not None:
             writable.append(hit)
-            insts.append(rb_and(wr_now, hit, we))
         if r.kind == "const":
             words.append((hit, Signal(intbv(r.reset_value(params))[32:])))
         elif r.kind == "rw":
@@ -496,30 +499,16 @@ def register_bank(clk, rst, bus, regs, arb, fcount, host, *, width: int = 352, h
                 rvalid.next = 0
                 state.next = t_state.IDLE
 
+    insts += [assign(q, port) for q, port in (
+        (awready, bus.awready), (wready, bus.wready), (arready, bus.arready), (bvalid, bus.bvalid),
+        (bresp, bus.bresp), (rvalid, bus.rvalid), (rresp, bus.rresp), (rdata, bus.rdata),
+        (req_valid, host.req_valid), (req_we, host.req_we))]
+
     @always_comb
     def outputs():
-        bus.awready.next = awready
-        bus.wready.next = wready
-        bus.arready.next = arready
-        bus.bvalid.next = bvalid
-        bus.bresp.next = bresp
-        bus.rvalid.next = rvalid
-        bus.rresp.next = rresp
-        bus.rdata.next = rdata
-        host.req_valid.next = req_valid
-        host.req_we.next = req_we
         host.req_addr.next = waddr[len(host.req_addr):0]
         host.req_wdata.next = wdata[16:0]
         host.req_be.next = wstrb[2:0]
 
     insts += [mux_reg, decode, fsm, outputs]
     return insts
-
-
-@block
-def rb_and(a, b, out):
-    @always_comb
-    def comb():
-        out.next = a and b
-
-    return comb

@@ -1,4 +1,4 @@
-"""The stereo front end: two cameras -> SRAM -> rectifier -> stereo Harris -> feature lists, on an AXI4-Lite bus (thesis Fig. 7.2)."""
+"""The stereo front end (thesis Fig. 7.2): cameras -> SRAM -> rectifier -> stereo Harris -> features, on AXI4-Lite."""
 
 from __future__ import annotations
 
@@ -13,9 +13,10 @@ from eyestereo.hdl.harris.feature_list import addr_bits, count_bits, feature_lis
 from eyestereo.hdl.rectify.fetch_interpolate import DEFAULT_DEPTH
 from eyestereo.hdl.interfaces.fetch_port import FetchPort
 from eyestereo.hdl.memory.frame_buffers import FrameControl
+from eyestereo.hdl.system.frame_handshake import frame_handshake
 from eyestereo.hdl.system.frontend_sequencer import frontend_sequencer
 from eyestereo.hdl.harris.harris_stereo import harris_stereo
-from eyestereo.hdl.rectify.poly_unit import calibration_param
+from eyestereo.hdl.rectify.calibration import calibration_param
 from eyestereo.hdl.interfaces.queue import QueuePort
 from eyestereo.hdl.rectify.rectifier import rectifier
 from eyestereo.hdl.system.register_bank import RegisterPorts, register_bank
@@ -27,19 +28,21 @@ from eyestereo.hdl.streaming.word_cdc import word_cdc
 from eyestereo.tools.models import poly_unit as unit_model
 from eyestereo.tools.models.sram_arbiter import CAMERA_WORD
 from eyestereo.tools.camera import ORDERS
+from eyestereo.tools.constants import NMS_DEFAULT, NMS_SIZES, THRESHOLD_BLOCKS
 from eyestereo.tools.regmap import REGMAP
 from eyestereo.tools.sram import KINDS
 
 __all__ = ["stereo_frontend", "BLOCKS", "THR_BITS"]
 
-#: Threshold blocks per camera: the register map's 16 thresholds and 32 per-block counts.
-BLOCKS = (4, 4)
+#: Threshold blocks per camera (:data:`eyestereo.tools.constants.THRESHOLD_BLOCKS`): the register map's 16
+#: thresholds and 32 per-block counts.
+BLOCKS = THRESHOLD_BLOCKS
 THR_BITS = REGMAP["THR_LEFT"].fields[0].width
 
 
 @block
 def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sram, *, quantizers="rig",
-                    frac: int | None = unit_model.DEFAULT_FRAC, nms: int = 3, share: int = 1, border: int | None = None,
+                    frac: int | None = unit_model.DEFAULT_FRAC, nms: int = NMS_DEFAULT, border: int | None = None,
                     max_features: int = 1023, feature_words: int = 2048, cam_depth: int = 1024,
                     kind: str = "nobl", read_latency: int = 2, order: str = "YUYV", rect_depth: int = DEFAULT_DEPTH):
     """The complete stereo front end of the thesis's Fig. 7.2, with the processor's register bus.
@@ -50,9 +53,10 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     starts the :func:`~eyestereo.hdl.rectify.rectifier.rectifier`, which reads them through the arbiter's fetch
     port; its 8-bit stereo stream goes both into the rectified-image buffers (the arbiter's rect writer:
     left and right pixel of (x, y) in one word) and, through a
-    :func:`~eyestereo.hdl.streaming.stream_cdc.stream_cdc`, into :func:`~eyestereo.hdl.harris.harris_stereo.harris_stereo`
-    in the Harris clock. Its corner flags come back through a second stream_cdc into the memory clock,
-    where :func:`~eyestereo.hdl.harris.feature_list.feature_list` makes the feature words (the arbiter's feature
+    :func:`~eyestereo.hdl.streaming.stream_cdc.stream_cdc`, into
+    :func:`~eyestereo.hdl.harris.harris_stereo.harris_stereo` in the Harris clock. Its corner flags come
+    back through a second stream_cdc into the memory clock, where
+    :func:`~eyestereo.hdl.harris.feature_list.feature_list` makes the feature words (the arbiter's feature
     writer) and the per-block counts (the register bank's FCOUNT window, read directly). k (a
     :func:`~eyestereo.hdl.streaming.word_cdc.word_cdc`) and the block thresholds (one-beat frames of 25 bits: camera,
     block, code, through a stream_cdc) cross into the Harris clock; the crossing's dropped-frame count
@@ -63,8 +67,8 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     Ports:
         clk, rst: the memory clock (100 MHz: SRAM, arbiter, rectifier, feature list, register bus) and
             its synchronous active-high reset.
-        hclk, hrst: the Harris clock (50 MHz in the thesis; harris_stereo share 1 takes a beat per clock,
-            so any hclk of at least half the memory clock keeps up with the rectifier) and its reset.
+        hclk, hrst: the Harris clock (50 MHz in the thesis; harris_stereo, built with share 1, takes a beat
+            per clock, so any hclk of at least half the memory clock keeps up with the rectifier) and its reset.
         cam_l, wrst_l, cam_r, wrst_r: the camera buses (:class:`~eyestereo.hdl.interfaces.camera_bus.CameraBus`,
             each clocked by its own PCLK) and each camera domain's synchronous reset.
         bus: :class:`~eyestereo.hdl.interfaces.axil.AxiLite` slave (the register map's address bits), memory clock.
@@ -74,7 +78,8 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
         quantizers, frac: the calibration (a spec such as ``"rig:64x48"``, a quantizers.json or a
             Calibration; its rectified size must equal its camera size: the frame buffers are one size),
             as for the rectifier. The frame size is the calibration's.
-        nms, share: harris_stereo's (default share 1: a beat per Harris clock).
+        nms: harris_stereo's. Its ``share`` is not a parameter here: the rectifier's stream comes up to a beat
+            every 2 Harris clocks with no back-pressure, which only share 1 (a beat per clock) takes.
         border: feature_list's border (default harris_stereo's r = 3 + nms // 2).
         max_features, feature_words: features per list and the SRAM words of each list buffer.
         cam_depth: each camera FIFO's entries (1024 = one RAMB16).
@@ -102,11 +107,7 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
         raise block_error(f"parameter quantizers: the calibration rectifies {cal.source_width}x{cal.source_height} "
                           f"camera images to {cal.width}x{cal.height}; the front end's buffers need one size")
     width, height = cal.width, cal.height
-    nms = check_choice("nms", nms, (1, 3, 5))
-    share = check_choice("share", share, (1, 2, 3))
-    if share != 1:
-        raise block_error(f"parameter share={share}: the rectifier's stream comes up to a beat every 2 Harris "
-                          "clocks with no back-pressure; only share 1 takes it")
+    nms = check_choice("nms", nms, NMS_SIZES)
     border = 3 + nms // 2 if border is None else check_int("border", border, 1)
     max_features = check_int("max_features", max_features, 1, 32767)
     feature_words = check_int("feature_words", feature_words, 2, 65536)
@@ -189,7 +190,7 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     insts += [to_harris_m, to_harris_h]
     h_flags, flags = ImageStream(1, stereo=True), ImageStream(1, stereo=True)
     insts.append(harris_stereo(hclk, hrst, h_in, h_flags, k_l_h, k_r_h, thr_we, thr_cam, thr_addr, thr_data,
-                               width=width, height=height, blocks=BLOCKS, nms=nms, share=share))
+                               width=width, height=height, blocks=BLOCKS, nms=nms, share=1))
     f_dropped = Signal(intbv(0)[16:])
     insts.append(stream_cdc(hclk, hrst, h_flags, clk, rst, flags, f_dropped, depth=16))
 
@@ -215,17 +216,10 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
         regs.features_left.next = tot_l if tot_l <= top else top
         regs.features_right.next = tot_r if tot_r <= top else top
 
+    insts.append(frame_handshake(regs, ctl))
+
     @always_comb
     def wiring():
-        ctl.rect_want.next = regs.rect_want
-        ctl.feat_want.next = regs.feat_want
-        ctl.rect_release.next = regs.rect_release
-        ctl.feat_release.next = regs.feat_release
-        regs.avail.next = ctl.avail
-        regs.rect_held.next = ctl.rect_held
-        regs.feat_held.next = ctl.feat_held
-        regs.rect_buf.next = ctl.rect_buf
-        regs.feat_buf.next = ctl.feat_buf
         regs.dropped_left.next = dropped_l
         regs.dropped_right.next = dropped_r
         regs.harris_overflows.next = h_dropped_m + f_dropped

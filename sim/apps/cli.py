@@ -42,12 +42,14 @@ def write_vhdl(quantizers: str | os.PathLike[str], folder: Path, *, source_width
     which a tight error bound can push beyond that limit: ValueError, in one line, before anything is
     written (as for a missing GHDL)."""
     from eyestereo.hdl.flow.convert import GHDL_STDS, analyse, convert, vhdl_ports
+    from eyestereo.hdl.rectify.calibration import calibration_param
     from eyestereo.tools.models.fetch_interpolate import MAX_FRAC
-    from eyestereo.tools.models.poly_unit import Calibration, resolve_frac
+    from eyestereo.tools.models.poly_unit import resolve_frac
 
     if shutil.which("ghdl") is None:
         raise ValueError("ghdl not found: install GHDL (Debian: apt-get install ghdl) to write the rectifier's VHDL")
-    cal = Calibration.load(str(quantizers), source_width=source_width, source_height=source_height)
+    # the calibration the conversion below resolves from the same parameters
+    cal = calibration_param(str(quantizers), source_width, source_height)
     given = frac
     frac = resolve_frac(cal, frac)
     if frac > MAX_FRAC:
@@ -108,8 +110,9 @@ def _wrap_rectifier(parser: argparse.ArgumentParser) -> None:
         if shutil.which("ghdl") is None:
             raise ValueError("ghdl not found: install GHDL (Debian: apt-get install ghdl) to write the rectifier's "
                              "VHDL")
+        from eyestereo.hdl.rectify.calibration import calibration_param
         from eyestereo.tools.io import Outputs
-        from eyestereo.tools.models.poly_unit import Calibration, resolve_frac
+        from eyestereo.tools.models.poly_unit import resolve_frac
         from eyestereo.tools.rectify.calib import read_yaml
         from eyestereo.tools.rectify.calibrations import MAX_SIDE, MIN_SIDE
 
@@ -130,7 +133,7 @@ def _wrap_rectifier(parser: argparse.ArgumentParser) -> None:
             if not (tmp / "quantizers.json").exists():
                 raise ValueError("no quantizers.json (the VHDL needs degree 3); nothing written")
             if args.frac is None:
-                q24 = resolve_frac(Calibration.load(str(tmp / "quantizers.json"), source_width=sw, source_height=sh))
+                q24 = resolve_frac(calibration_param(str(tmp / "quantizers.json"), sw, sh))
                 if q24 > MAX_FRAC:
                     raise ValueError(f"--max-error {args.max_error:g} ({args.measure}) gives the rectifier's "
                                      f"coordinates {q24} fraction bits (q24's); its interpolation takes at most "

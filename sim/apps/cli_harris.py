@@ -1,4 +1,6 @@
-"""``eyestereo sim harris``: the stereo Harris HDL in a simulator on an image pair (added by ``eyestereo.sim.apps.cli``).
+"""``eyestereo sim harris``: the stereo Harris HDL in a simulator on an image pair.
+
+A command of ``eyestereo sim``, added by ``eyestereo.sim.apps.cli``.
 
 ``eyestereo sim harris LEFT RIGHT -o OUT``: the generated ``harris_stereo`` on a stereo pair of images of
 any size (5..4096 pixels a side), read by the library's one image rule (colour to grey, 16-bit to its 8
@@ -25,6 +27,7 @@ import numpy as np
 
 from eyestereo.sim.apps.cli_rectify import add_build_dir
 from eyestereo.tools.cli.common import number
+from eyestereo.tools.constants import FRAME_MAX, K_DEFAULT, NMS_DEFAULT, NMS_SIZES, SHARE_FACTORS, THRESHOLD_BLOCKS
 from eyestereo.tools.io import Outputs
 from eyestereo.tools.progress import progress_bar
 
@@ -60,8 +63,8 @@ def add_harris(sub: Any) -> None:
     p.add_argument("right", type=Path, help="right grey image, the same size")
     p.add_argument("-o", "--output", type=Path, required=True,
                    help="folder for corners.json, left.png, right.png; created, or replaced when it holds only these")
-    p.add_argument("--k", type=lambda t: number(t, float, 0.0, 255 / 256, "--k"), default=0.04,
-                   help="Harris k for both cameras (default 0.04)")
+    p.add_argument("--k", type=lambda t: number(t, float, 0.0, 255 / 256, "--k"), default=K_DEFAULT,
+                   help=f"Harris k for both cameras (default {K_DEFAULT})")
     p.add_argument("--k-left", dest="k_left", type=lambda t: number(t, float, 0.0, 255 / 256, "--k-left"), default=None)
     p.add_argument("--k-right", dest="k_right", type=lambda t: number(t, float, 0.0, 255 / 256, "--k-right"),
                    default=None)
@@ -70,9 +73,11 @@ def add_harris(sub: Any) -> None:
                         "block, or BX*BY comma-separated values by block index by*BX+bx (default 1e8)")
     p.add_argument("--threshold-left", dest="threshold_left", type=_thresholds, default=None)
     p.add_argument("--threshold-right", dest="threshold_right", type=_thresholds, default=None)
-    p.add_argument("--blocks", type=_blocks, default=(4, 4), help="threshold blocks BXxBY (default 4x4)")
-    p.add_argument("--nms", type=int, choices=(1, 3, 5), default=3, help="non-maximum suppression (default 3)")
-    p.add_argument("--share", type=int, choices=(1, 2, 3), default=3,
+    p.add_argument("--blocks", type=_blocks, default=THRESHOLD_BLOCKS,
+                   help="threshold blocks BXxBY (default {}x{})".format(*THRESHOLD_BLOCKS))
+    p.add_argument("--nms", type=int, choices=NMS_SIZES, default=NMS_DEFAULT,
+                   help=f"non-maximum suppression (default {NMS_DEFAULT})")
+    p.add_argument("--share", type=int, choices=SHARE_FACTORS, default=3,
                    help="clocks the multipliers are shared over (default 3, the thesis's design)")
     p.add_argument("--sim", choices=("ghdl", "icarus", "verilator"), default=None,
                    help="simulator: ghdl (the VHDL; default, or $SIM), icarus or verilator (MyHDL's Verilog)")
@@ -112,14 +117,15 @@ def cmd_harris(args: argparse.Namespace) -> int:
     left, right = read_pair(args.left, args.right)
     h, w = left.shape
     r = radius(args.nms)
-    if min(w, h) < max(5, 2 * r + 1) or max(w, h) > 4096:
-        raise ValueError(f"the images are {w}x{h}: harris_stereo takes {2 * r + 1}..4096 pixels a side "
+    if min(w, h) < max(5, 2 * r + 1) or max(w, h) > FRAME_MAX:
+        raise ValueError(f"the images are {w}x{h}: harris_stereo takes {2 * r + 1}..{FRAME_MAX} pixels a side "
                          f"(nms {args.nms})")
     bx, by = args.blocks
     if bx > w or by > h:
         raise ValueError(f"--blocks {bx}x{by} is more than the image's {w}x{h} pixels")
     n = bx * by
-    k = [k_code(args.k if args.k_left is None else args.k_left), k_code(args.k if args.k_right is None else args.k_right)]
+    k = [k_code(args.k if args.k_left is None else args.k_left),
+         k_code(args.k if args.k_right is None else args.k_right)]
     thr = [_per_block(args.threshold if args.threshold_left is None else args.threshold_left, n, "--threshold-left"
                       if args.threshold_left is not None else "--threshold"),
            _per_block(args.threshold if args.threshold_right is None else args.threshold_right, n, "--threshold-right"

@@ -1,4 +1,6 @@
-"""``eyestereo sim rectify``: a generated rectifier's VHDL in GHDL on a stereo pair (added by ``eyestereo.sim.apps.cli``).
+"""``eyestereo sim rectify``: a generated rectifier's VHDL in GHDL on a stereo pair.
+
+A command of ``eyestereo sim``, added by ``eyestereo.sim.apps.cli``.
 
 ``eyestereo sim rectify DIR LEFT RIGHT -o OUT``: ``DIR`` is the output of ``eyestereo rectifier CALIB -o DIR
 --vhdl`` (its ``quantizers.json`` and ``vhdl/``); the pair (the calibration's camera size; read by the
@@ -89,8 +91,9 @@ def run_vhdl(sources: list[str], cfg: dict, build_dir: str) -> dict:
                  log_file=build / "build.log")
     env = {"EYESTEREO_TB": json.dumps(full),
            "PYTHONPATH": os.pathsep.join([str(SIM_DIR), os.environ.get("PYTHONPATH", "")])}
-    results = runner.test(hdl_toplevel="rectifier", hdl_toplevel_lang="vhdl", test_module="eyestereo.sim.benches.tb_rectifier",
-                          build_dir=build, test_dir=build, test_args=GHDL_ARGS, extra_env=env,
+    results = runner.test(hdl_toplevel="rectifier", hdl_toplevel_lang="vhdl",
+                          test_module="eyestereo.sim.benches.tb_rectifier", build_dir=build, test_dir=build,
+                          test_args=GHDL_ARGS, extra_env=env,
                           plusargs=GHDL_RUN_OPTIONS, log_file=log)
     n_tests, n_failed = get_results(results)
     if n_tests == 0 or n_failed:

@@ -1,4 +1,6 @@
-"""``eyestereo sim system``: the complete front end in a simulator on a stereo pair (added by ``eyestereo.sim.apps.cli``).
+"""``eyestereo sim system``: the complete front end in a simulator on a stereo pair.
+
+A command of ``eyestereo sim``, added by ``eyestereo.sim.apps.cli``.
 
 ``eyestereo sim system LEFT RIGHT -o OUT [--json FILE]``: both images, read by the library's one image rule
 (:func:`eyestereo.sim.apps.cli_rectify.read_pair`: colour to grey, 16-bit to its 8 most significant used bits,
@@ -30,7 +32,9 @@ from typing import Any
 import numpy as np
 
 from eyestereo.sim.apps.cli_rectify import add_build_dir
+from eyestereo.sim.lib.frontend_runs import CLOCKS, PUBLIC, SHORT_BLANKING, figures
 from eyestereo.tools.cli.common import integer
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 from eyestereo.tools.models.sram_arbiter import MASTERS
 
 MODES = ("sequential", "overlapped")
@@ -39,7 +43,7 @@ MAX_FRAMES = 64
 #: What the command writes into OUT.
 OWNED = ("rectified.png", "matches.png", "summary.json")
 #: The camera timing of the command's runs (a short blanking: the small frames go fast).
-TIMING = dict(h_blank=64, v_sync=1, v_back=1, v_front=1)
+TIMING = SHORT_BLANKING
 #: The bench's Python packages beyond the library's own (named in the error when one is missing).
 BENCH_PACKAGES = {"cocotbext.axi": "cocotbext-axi"}
 
@@ -50,8 +54,8 @@ def frame_size(text: str) -> tuple[int, int]:
         w, h = (int(v) for v in text.lower().split("x"))
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected WxH like 48x32, got {text!r}") from None
-    if not (16 <= w <= 352 and 16 <= h <= 288 and w % 2 == 0):
-        raise argparse.ArgumentTypeError(f"size {text}: width even, 16..352 x 16..288")
+    if not (16 <= w <= FRAME_WIDTH and 16 <= h <= FRAME_HEIGHT and w % 2 == 0):
+        raise argparse.ArgumentTypeError(f"size {text}: width even, 16..{FRAME_WIDTH} x 16..{FRAME_HEIGHT}")
     return w, h
 
 
@@ -160,8 +164,6 @@ def check_bench_packages() -> None:
 
 def run_mode(mode: str, work: Path, *, size, frames: int, sim: str) -> tuple[str, dict, Path]:
     """The job (:func:`eyestereo.sim.apps.job.run_jobs`) of one mode's run, in its own folder below ``work``."""
-    from eyestereo.sim.measure.bench_stereo_frontend import PUBLIC
-
     w, h = size
     folder = work / mode
     folder.mkdir()
@@ -169,7 +171,8 @@ def run_mode(mode: str, work: Path, *, size, frames: int, sim: str) -> tuple[str
             dict(block="stereo_frontend", bench="tb_stereo_frontend",
                  config=dict(mode=mode, frames=frames, pair=[str(work / "left.npy"), str(work / "right.npy")],
                              timing=TIMING),
-                 name=f"cli_{mode}_{w}x{h}", params=dict(quantizers=f"rig:{w}x{h}", feature_words=512, max_features=255),
+                 name=f"cli_{mode}_{w}x{h}",
+                 params=dict(quantizers=f"rig:{w}x{h}", feature_words=512, max_features=255),
                  build_root=folder / "build", log_file=folder / f"{mode}.log", sim=sim,
                  public=PUBLIC if sim == "verilator" else None),
             folder)
@@ -182,7 +185,6 @@ def simulate(left: np.ndarray, right: np.ndarray, folder: Path, work: Path, *, s
     returns the summary. :class:`eyestereo.sim.apps.job.JobFailed` when a simulation fails."""
     import cv2
 
-    from eyestereo.sim.measure.bench_stereo_frontend import figures
     from eyestereo.sim.apps.job import run_jobs
     from eyestereo.sim.lib.runner import describe
     from eyestereo.tools.camera import CameraTiming
@@ -206,7 +208,7 @@ def simulate(left: np.ndarray, right: np.ndarray, folder: Path, work: Path, *, s
                    sram_busy={m: f["sram_busy"] for m, f in figs.items()},
                    features_last_frame=len(last["features"]), matches_last_frame=matched,
                    bit_exact=all(r["bit_exact"] for r in reps.values()), simulator=describe(sim),
-                   clocks={"memory": 100.0, "harris": 50.0, "camera_l": 18.0, "camera_r": 17.9})
+                   clocks=CLOCKS)
     atomic_write_text(folder / "summary.json", json.dumps(summary, indent=2) + "\n")
     return summary
 

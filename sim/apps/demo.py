@@ -27,12 +27,13 @@ import numpy as np
 from eyestereo.sim.lib.bench import make_frame
 from eyestereo.sim.lib.runner import ROOT, run_bench
 from eyestereo.sim.apps.steps import StepFailed, StepRunner
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH, K_CODE_DEFAULT, NMS_DEFAULT, THRESHOLD_BLOCKS
 from eyestereo.tools.models import harris_mono as hm
 from eyestereo.tools.models import prethreshold as pt
 from eyestereo.tools.models import sobel as model
 
 IMAGE = "tsukuba_im3.png"
-WIDTH, HEIGHT = 352, 288
+WIDTH, HEIGHT = FRAME_WIDTH, FRAME_HEIGHT
 
 
 def gradient_picture(g: np.ndarray, mask: np.ndarray) -> np.ndarray:
@@ -49,13 +50,11 @@ SYSTEM_FRAMES = 2
 SYSTEM_MODES = ["sequential", "overlapped"]
 
 TARGET = 300  # corners per frame, both runs
-K = 0.04
 
 
 def block_thresholds(frame: np.ndarray, blocks: tuple[int, int], target: int) -> list[int]:
     """Threshold codes that leave about ``target`` corners in the frame, spread evenly over the blocks."""
-    k = hm.k_code(K)
-    s = hm.harris_stages(frame, k, [0] * (blocks[0] * blocks[1]), blocks=blocks, nms=3)
+    s = hm.harris_stages(frame, K_CODE_DEFAULT, [0] * (blocks[0] * blocks[1]), blocks=blocks, nms=NMS_DEFAULT)
     cand = (s["flags"] > 0) & s["mask"]
     idx = pt.block_index(*frame.shape, blocks)
     per = max(1, target // (blocks[0] * blocks[1]))
@@ -83,10 +82,10 @@ def run_harris(out: Path, frame: np.ndarray, blocks: tuple[int, int]) -> tuple[n
     name = f"harris_{blocks[0]}x{blocks[1]}"
     dump = out / f"{name}_frames.npy"
     report = run_bench("harris_mono", "tb_harris_mono",
-                       dict(frames=[f"file:{IMAGE}"], duty=1.0, k=hm.k_code(K), thresholds=thr, dump=str(dump)),
-                       name=f"demo_{name}", params=dict(width=WIDTH, height=HEIGHT, blocks=blocks, nms=3))
+                       dict(frames=[f"file:{IMAGE}"], duty=1.0, k=K_CODE_DEFAULT, thresholds=thr, dump=str(dump)),
+                       name=f"demo_{name}", params=dict(width=WIDTH, height=HEIGHT, blocks=blocks, nms=NMS_DEFAULT))
     flags = np.load(dump)[0]
-    _, mask = hm.harris_mono(frame, hm.k_code(K), thr, blocks=blocks, nms=3)
+    _, mask = hm.harris_mono(frame, K_CODE_DEFAULT, thr, blocks=blocks, nms=NMS_DEFAULT)
     return flags * mask, report
 
 
@@ -176,7 +175,7 @@ def main(argv=None) -> int:
         steps.run(f"stereo front end ({'Verilator' if system_sim == 'verilator' else 'GHDL'})", system_step)
         steps.run("sobel (VHDL, GHDL)", sobel_step)
         steps.run("harris_mono, 1 threshold", harris_step((1, 1)))
-        steps.run("harris_mono, 4x4 thresholds", harris_step((4, 4)))
+        steps.run("harris_mono, {}x{} thresholds".format(*THRESHOLD_BLOCKS), harris_step(THRESHOLD_BLOCKS))
     except StepFailed:
         return 1
     steps.say(f"4 steps, every output bit-exact, {steps.seconds:.0f} s; input.png and the pictures are in {rel}/")

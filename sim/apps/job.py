@@ -38,7 +38,8 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
-__all__ = ["GRACE", "JobFailed", "check_build_dir", "default_build_dir", "file_progress", "run_folder", "run_job", "run_jobs"]
+__all__ = ["GRACE", "JobFailed", "check_build_dir", "default_build_dir", "file_progress", "run_folder", "run_job",
+           "run_jobs"]
 
 #: Seconds between SIGTERM and SIGKILL when a job is stopped.
 GRACE = 1.0

@@ -92,7 +92,8 @@ async def fifo_frames(dut):
     if mon.beats != want:
         i = next((i for i, (a, b) in enumerate(zip(mon.beats, want)) if a != b), min(len(mon.beats), len(want)))
         raise AssertionError(f"{len(mon.beats)} words out, model {len(want)}; first difference at word {i}: got "
-                             f"{mon.beats[i] if i < len(mon.beats) else None}, want {want[i] if i < len(want) else None}")
+                             f"{mon.beats[i] if i < len(mon.beats) else None}, "
+                             f"want {want[i] if i < len(want) else None}")
     done = []
     w, h = cfg["width"], cfg["height"]
     for kind, tag, words in model.segments():

@@ -20,7 +20,7 @@ from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
 
 from eyestereo.sim.lib.axis import axis_source, beats_to_packets, pauses
-from eyestereo.sim.lib.bench import load_config, make_frame, write_report
+from eyestereo.sim.lib.bench import frame_params, load_config, make_frame, write_report
 from eyestereo.sim.lib.stream import StreamSink
 from eyestereo.tools.models.axis_to_stream import axis_to_stream
 from eyestereo.tools.models.stream_to_axis import to_axis
@@ -57,9 +57,7 @@ def stimulus(frames, faults, width):
 @cocotb.test()
 async def axis_to_stream_frames(dut):
     cfg = load_config()
-    p = cfg["params"]
-    w, h = p["width"], p["height"]
-    bits = p.get("data_width", 8)
+    w, h, bits = frame_params(cfg)
     dut.rst.value = 1
     dut.sink_tvalid.value = 0
     Clock(dut.clk, 10, unit="ns").start()

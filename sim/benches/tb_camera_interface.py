@@ -31,40 +31,23 @@ import cocotb
 import numpy as np
 
 from eyestereo.sim.lib.bench import load_config, write_report
-from eyestereo.sim.lib.camera import CameraModel, camera_frame
+from eyestereo.sim.lib.camera import CameraModel
+from eyestereo.sim.lib.camera_config import camera_schedule, resets_of, timing_of
 from eyestereo.sim.lib.queue import EdgeClock, QueueMonitor, drive_intervals, wait_until
-from eyestereo.tools.camera import CameraTiming, Fault, cut, frame_schedule, run_length, vsyncs_before
+from eyestereo.tools.camera import CameraTiming, run_length
 from eyestereo.tools.models.async_fifo import ClockSpec
 from eyestereo.tools.models.camera_interface import camera_interface
-
-INIT_RESET = (0, 3)  # edges of each domain with its reset high at the start
-
-
-def timing_of(cfg: dict) -> CameraTiming:
-    p = cfg["params"]
-    return CameraTiming(width=p["width"], height=p["height"], order=p["order"], vsync_active=p["vsync_active"],
-                        href_active=p["href_active"], **cfg.get("timing", {}))
-
-
-def faults_of(spec: dict) -> dict[int, Fault]:
-    return {int(i): Fault(lines=f.get("lines"), line_bytes={int(k): int(v) for k, v in f.get("line_bytes", {}).items()})
-            for i, f in (spec or {}).items()}
 
 
 class Side:
     """One camera: its model, its port names, the model's prediction."""
 
     def __init__(self, dut, cfg: dict, cam: dict, timing: CameraTiming, rclk: ClockSpec, rresets):
-        w, h = timing.width, timing.height
         self.name = cam["prefix"]
         suffix = self.name[len("cam"):]  # "" or "_l" / "_r"
-        self.frames = [camera_frame(s, w, h) for s in cam["frames"]]
-        full = frame_schedule(self.frames, timing, faults=faults_of(cam.get("faults")))
-        start = int(cam.get("start", 0))
-        self.offset = vsyncs_before(full, start)
-        self.runs = cut(full, start, preroll=int(cam.get("preroll", 8)))
+        self.frames, self.offset, self.runs = camera_schedule(cam, timing)
         self.pclk = ClockSpec(*cam["pclk"])
-        self.wresets = [INIT_RESET] + [tuple(r) for r in cam.get("wresets", [])]
+        self.wresets = resets_of(cam.get("wresets"))
         self.stalls = [tuple(s) for s in cam.get("stalls", [])]
         t0 = time.time()
         self.model = camera_interface(self.runs, timing, depth=cfg["params"]["depth"], pclk=self.pclk, rclk=rclk,
@@ -89,7 +72,7 @@ async def camera_frames(dut):
     cfg = load_config()
     timing = timing_of(cfg)
     rclk = ClockSpec(*cfg["rclk"])
-    rresets = [INIT_RESET] + [tuple(r) for r in cfg.get("rresets", [])]
+    rresets = resets_of(cfg.get("rresets"))
     sides = [Side(dut, cfg, cam, timing, rclk, rresets) for cam in cfg["cameras"]]
     rclock = EdgeClock(dut.rclk, rclk)
     wall = time.time()

@@ -16,10 +16,10 @@ import numpy as np
 from cocotb.triggers import RisingEdge
 
 from eyestereo.sim.lib.bench import load_config, write_report
-from eyestereo.sim.lib.camera import CameraModel, camera_frame
+from eyestereo.sim.lib.camera import CameraModel
+from eyestereo.sim.lib.camera_config import camera_schedule, resets_of, timing_of
 from eyestereo.sim.lib.queue import EdgeClock, drive_intervals, wait_until
-from eyestereo.sim.benches.tb_camera_interface import INIT_RESET, faults_of, timing_of
-from eyestereo.tools.camera import cut, frame_schedule, run_length, vsyncs_before
+from eyestereo.tools.camera import run_length
 from eyestereo.tools.models.async_fifo import ClockSpec
 from eyestereo.tools.models.camera_stream import camera_stream, frames_of
 
@@ -59,13 +59,9 @@ async def camera_stream_frames(dut):
     cfg = load_config()
     timing = timing_of(cfg)
     w, h = timing.width, timing.height
-    frames = [camera_frame(s, w, h) for s in cfg["frames"]]
-    full = frame_schedule(frames, timing, faults=faults_of(cfg.get("faults")))
-    start = int(cfg.get("start", 0))
-    offset = vsyncs_before(full, start)
-    runs = cut(full, start, preroll=int(cfg.get("preroll", 8)))
+    frames, offset, runs = camera_schedule(cfg, timing)
     pclk = ClockSpec(*cfg["pclk"])
-    resets = [INIT_RESET] + [tuple(r) for r in cfg.get("resets", [])]
+    resets = resets_of(cfg.get("resets"))
     model = camera_stream(runs, timing, resets=resets)
 
     cam = CameraModel(dut, "cam", timing, pclk.period, pclk.phase)
@@ -90,7 +86,8 @@ async def camera_stream_frames(dut):
     if rec.beats != want:
         i = next((i for i, (a, b) in enumerate(zip(rec.beats, want)) if a != b), min(len(rec.beats), len(want)))
         raise AssertionError(f"{len(rec.beats)} beats out, model {len(want)}; first difference at beat {i}: got "
-                             f"{rec.beats[i] if i < len(rec.beats) else None}, want {want[i] if i < len(want) else None}")
+                             f"{rec.beats[i] if i < len(rec.beats) else None}, "
+                             f"want {want[i] if i < len(want) else None}")
     got_frames, ids, aborted = frames_of(model, w, h, resets=resets)
     for f, i in zip(got_frames, ids):
         assert np.array_equal(f, frames[i + offset]), f"frame {i + offset} differs from the camera's"

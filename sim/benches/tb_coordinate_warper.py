@@ -22,21 +22,18 @@ from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, FallingEdge, First, ReadOnly, RisingEdge, Timer
 from cocotb.utils import get_sim_time
 
-from eyestereo.sim.lib.bench import load_config, write_report
-from eyestereo.sim.benches.tb_poly_unit import calibration, random_codes, write_coefficients
+from eyestereo.sim.lib.bench import write_report
+from eyestereo.sim.lib.rectify_bench import PERIOD, random_codes, rectify_config, reset, write_coefficients
 from eyestereo.tools.models import coordinate_warper as model
 from eyestereo.tools.models import poly_unit as unit_model
 
-PERIOD = 10  # ns
-
 
 class WarperTB:
-    def __init__(self, dut, cfg):
+    def __init__(self, dut):
         self.dut = dut
+        cfg, self.cal, self.frac = rectify_config()
         self.cfg = cfg
         p = cfg["params"]
-        self.cal = calibration(p)
-        self.frac = unit_model.resolve_frac(self.cal, p.get("frac"))
         self.batch = int(p.get("batch", 16))
         self.word = model.pair_word(self.cal, self.frac)
         self.clk = dut.clk
@@ -56,11 +53,7 @@ class WarperTB:
             dut.coef_data.value = 0
 
     async def reset(self):
-        await FallingEdge(self.clk)
-        self.dut.rst.value = 1
-        await ClockCycles(self.clk, 3)
-        await FallingEdge(self.clk)
-        self.dut.rst.value = 0
+        await reset(self.dut, self.clk)
         self.already = 0
 
     def _bits(self, value, n: int) -> np.ndarray:
@@ -138,8 +131,8 @@ class WarperTB:
 
 @cocotb.test()
 async def coordinate_warper_frames(dut):
-    cfg = load_config()
-    tb = WarperTB(dut, cfg)
+    tb = WarperTB(dut)
+    cfg = tb.cfg
     await tb.reset()
     cal = tb.cal
     if cfg.get("coefficients") == "random":
@@ -164,7 +157,7 @@ async def coordinate_warper_frames(dut):
         assert int(dut.busy.value) == 0 and int(dut.takes.value) == 0, "rst must end the frame"
         tb.rows = []
 
-    for f in range(frames):
+    for _ in range(frames):
         c_start = await tb.pulse_start()
         await tb.collect(poke_start=bool(cfg.get("start_while_busy")))
         tb.frame_clocks.append(tb.done_cycle - c_start)  # from the start clock to the done clock

@@ -4,6 +4,7 @@ import cocotb
 import numpy as np
 
 from eyestereo.sim.lib.bench import StreamTB, run_configured
+from eyestereo.tools.constants import K_CODE_DEFAULT
 from eyestereo.tools.models import cornerness as model
 
 
@@ -12,7 +13,7 @@ class CornernessTB(StreamTB):
 
     @property
     def k(self) -> int:
-        return int(self.cfg.get("k", 10))
+        return int(self.cfg.get("k", K_CODE_DEFAULT))
 
     async def configure(self):
         self.dut.k.value = self.k

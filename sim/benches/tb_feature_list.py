@@ -20,6 +20,7 @@ from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge, Timer
 
 from eyestereo.sim.lib.bench import load_config, make_frame, write_report
 from eyestereo.sim.lib.stream import BeatSource, IdleGenerator
+from eyestereo.tools.constants import K_CODE_DEFAULT, NMS_DEFAULT
 from eyestereo.tools.models import feature_list as model
 from eyestereo.tools.models import harris_stereo as harris_model
 from eyestereo.tools.models.stream_checker import frame_beats
@@ -29,14 +30,17 @@ PERIOD_NS = 10
 
 
 def flag_pair(spec: str, w: int, h: int, rng) -> tuple[np.ndarray, np.ndarray]:
-    """``flags:DENSITY`` random flags; ``harris:SEED`` the stereo Harris model's flags of random images (k 10, nms 3)."""
+    """``flags:DENSITY`` random flags; ``harris:SEED`` the stereo Harris model's flags of random images.
+
+    The Harris model runs with k code 10 and a 3x3 non-maximum suppression.
+    """
     kind, _, arg = spec.partition(":")
     if kind == "flags":
         d = float(arg)
         return (rng.random((h, w)) < d).astype(np.int64), (rng.random((h, w)) < d).astype(np.int64)
     if kind == "harris":
         left, right = make_frame(f"random:{arg}", w, h), make_frame(f"random:{int(arg) + 1}", w, h)
-        fl, fr, _ = harris_model.harris_stereo(left, right, 10, [0], blocks=(1, 1), nms=3)
+        fl, fr, _ = harris_model.harris_stereo(left, right, K_CODE_DEFAULT, [0], blocks=(1, 1), nms=NMS_DEFAULT)
         return fl, fr
     raise ValueError(f"unknown flag stimulus {spec!r}")
 
@@ -173,7 +177,8 @@ async def feature_list_frames(dut):
         assert pub["total_left"] == res["totals"][0] and pub["total_right"] == res["totals"][1], \
             f"frame {i}: totals {pub['total_left']}, {pub['total_right']}, expected {res['totals'].tolist()}"
         assert pub["overflow"] == int(res["overflow"]), f"frame {i}: overflow {pub['overflow']}"
-        assert (pub["counts"] == res["counts"]).all(), f"frame {i}: counts {pub['counts'].tolist()} != {res['counts'].tolist()}"
+        assert (pub["counts"] == res["counts"]).all(), \
+            f"frame {i}: counts {pub['counts'].tolist()} != {res['counts'].tolist()}"
     lists = model.parse_words(got)
     # Latency of the first feature of the first whole frame (FIFO empty, consumer ready): the cycle its
     # first word is on the port minus the cycle its flag's beat was driven.

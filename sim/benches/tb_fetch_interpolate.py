@@ -19,20 +19,19 @@ import random
 import cocotb
 import numpy as np
 from cocotb.clock import Clock
-from cocotb.triggers import ClockCycles
 
-from eyestereo.sim.lib.bench import load_config, write_report
+from eyestereo.sim.lib.bench import write_report
 from eyestereo.sim.lib.fetch_memory import Clocked, StereoMonitor, compare_requests, compare_stream
-from eyestereo.sim.benches.tb_rectifier import PERIOD, calibration, memory, quiet, reset, wait_beats
+from eyestereo.sim.lib.rectify_bench import PERIOD, memory, quiet, rectify_config, reset, wait_beats
 from eyestereo.tools.models import fetch_interpolate as model
-from eyestereo.tools.models.poly_unit import coord_format, resolve_frac
+from eyestereo.tools.models.poly_unit import coord_format
 
 
 def random_pairs(rng: np.random.Generator, n: int, sw: int, sh: int, frac: int, oor_p: float, nx: int,
                  ny: int) -> dict[str, np.ndarray]:
     out = {}
     steps = np.array([-2, -1, 0, 1, 1, 1, 2])
-    for side, (xk, yk, ok) in (("l", ("xl", "yl", "oor_l")), ("r", ("xr", "yr", "oor_r"))):
+    for xk, yk, ok in (("xl", "yl", "oor_l"), ("xr", "yr", "oor_r")):
         sx = rng.choice(steps, n)
         sy = rng.choice(np.array([-1, 0, 0, 0, 0, 1, 2]), n)
         jump = rng.random(n) < 0.02
@@ -87,10 +86,7 @@ class PairSource:
 
 @cocotb.test()
 async def fetch_interpolate_pairs(dut):
-    cfg = load_config()
-    p = cfg["params"]
-    cal = calibration(p)
-    frac = resolve_frac(cal, p.get("frac"))
+    cfg, cal, frac = rectify_config()
     sw, sh = cal.source_width, cal.source_height
     w, h, frames = int(cfg.get("width", 16)), int(cfg.get("height", 6)), int(cfg.get("frames", 2))
     n = w * h * frames

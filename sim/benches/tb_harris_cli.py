@@ -7,13 +7,11 @@ output frame and saves them as ``flags.npy`` (2, H, W); every 4096 input beats i
 
 import cocotb
 import numpy as np
-from cocotb.clock import Clock
-from cocotb.triggers import ClockCycles, RisingEdge
+from cocotb.triggers import ClockCycles
 
 from eyestereo.sim.lib.bench import load_config
-from eyestereo.sim.lib.stream import UNKNOWN, BeatMonitor, BeatSource
-from eyestereo.sim.benches.tb_harris_stereo import SpacedIdle, split_cameras, write_registers
-from eyestereo.tools.models import cornerness as corner_model
+from eyestereo.sim.lib.harris_ports import split_cameras, start_run
+from eyestereo.sim.lib.stream import UNKNOWN
 from eyestereo.tools.models.stream_checker import frame_beats
 
 
@@ -23,18 +21,7 @@ async def harris_cli(dut):
     p = cfg["params"]
     w, h, share = p["width"], p["height"], p["share"]
     pair = np.load(cfg["input"])
-    Clock(dut.clk, 10, unit="ns").start()
-    dut.thr_we.value = 0
-    dut.thr_cam.value = 0
-    dut.thr_addr.value = 0
-    dut.thr_data.value = 0
-    source = BeatSource(dut, "sink", dut.clk, SpacedIdle(share, 1.0, 0), period_ns=10)
-    dut.rst.value = 1
-    await ClockCycles(dut.clk, 3)
-    dut.rst.value = 0
-    await RisingEdge(dut.clk)
-    await write_registers(dut, dut.clk, cfg["k"], cfg["thresholds"], corner_model.OUT.wl)
-    monitor = BeatMonitor(dut, "source", dut.clk, period_ns=10)
+    source, monitor = await start_run(dut, share=share, k=cfg["k"], thresholds=cfg["thresholds"])
     beats = frame_beats(pair[0], stereo=True, right=pair[1])
     source.send_beats(beats)
     progress = cfg["progress"]

@@ -3,6 +3,7 @@
 import cocotb
 
 from eyestereo.sim.lib.bench import StreamTB, run_configured, write_thresholds
+from eyestereo.tools.constants import K_CODE_DEFAULT, NMS_DEFAULT, THRESHOLD_BLOCKS
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import harris_mono as model
 
@@ -11,9 +12,9 @@ class HarrisMonoTB(StreamTB):
     def __init__(self, dut, cfg, **kw):
         super().__init__(dut, cfg, **kw)
         p = cfg["params"]
-        self.blocks = tuple(p.get("blocks", (4, 4)))
-        self.nms = p.get("nms", 3)
-        self.k = int(cfg.get("k", model.k_code(0.04)))
+        self.blocks = tuple(p.get("blocks", THRESHOLD_BLOCKS))
+        self.nms = p.get("nms", NMS_DEFAULT)
+        self.k = int(cfg.get("k", K_CODE_DEFAULT))
         n = self.blocks[0] * self.blocks[1]
         thr = cfg.get("thresholds", [0] * n)
         self.thresholds = [int(t) for t in (thr if isinstance(thr, list) else [thr] * n)]

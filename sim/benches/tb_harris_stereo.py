@@ -12,38 +12,17 @@ specified flag equals :func:`eyestereo.hdl.harris.harris_stereo.latency`.
 
 from __future__ import annotations
 
-import random
-
 import cocotb
 import numpy as np
-from cocotb.clock import Clock
-from cocotb.triggers import ClockCycles, RisingEdge
+from cocotb.triggers import ClockCycles
 
 from eyestereo.sim.lib.bench import load_config, make_frame, write_report
-from eyestereo.sim.lib.stream import UNKNOWN, BeatMonitor, BeatSource
-from eyestereo.tools.models import cornerness as corner_model
+from eyestereo.sim.lib.harris_ports import split_cameras, start_run
+from eyestereo.tools.constants import K_CODE_DEFAULT, NMS_DEFAULT, THRESHOLD_BLOCKS
 from eyestereo.tools.models import harris_stereo as model
 from eyestereo.tools.models.harris_mono import radius
 from eyestereo.tools.models.stream_checker import frame_beats
-from eyestereo.tools.stream import TOKEN, FrameAssembler
-
-PERIOD_NS = 10
-
-
-class SpacedIdle:
-    """Offers a beat at least ``share`` clocks after the previous one, then each clock with probability ``duty``."""
-
-    def __init__(self, share: int, duty: float, seed: int):
-        self.share = share
-        self.duty = duty
-        self.rng = random.Random(seed)
-        self.since = share
-
-    def __call__(self) -> bool:
-        # called once per clock while beats wait: ``since`` = clocks since the last beat, this one included
-        ok = self.since >= self.share and (self.duty >= 1.0 or self.rng.random() < self.duty)
-        self.since = 1 if ok else self.since + 1
-        return ok
+from eyestereo.tools.stream import TOKEN
 
 
 def stereo_pair(spec: str, w: int, h: int):
@@ -55,58 +34,18 @@ def stereo_pair(spec: str, w: int, h: int):
     return make_frame(a, w, h), make_frame(b or a, w, h)
 
 
-async def write_registers(dut, clk, k, thresholds, bits):
-    dut.k_left.value = int(k[0])
-    dut.k_right.value = int(k[1])
-    for cam in (0, 1):
-        for i, v in enumerate(thresholds[cam]):
-            dut.thr_we.value = 1
-            dut.thr_cam.value = cam
-            dut.thr_addr.value = i
-            dut.thr_data.value = int(v) & ((1 << bits) - 1)
-            await RisingEdge(clk)
-    dut.thr_we.value = 0
-    await RisingEdge(clk)
-
-
-def split_cameras(beats, w, h):
-    """Two FrameAssemblers fed from output beats (cycle, data, eol, eof, cam); tokens reach both."""
-    asm = [FrameAssembler(w, h), FrameAssembler(w, h)]
-    order = []
-    for b in beats:
-        _, data, eol, eof, cam = b[:5]
-        if eof and not eol:
-            for a in asm:
-                a.push(*TOKEN)
-            order.append("token")
-        else:
-            asm[cam].push(data, bool(eol), bool(eof))
-    return asm, order
-
-
 @cocotb.test()
 async def harris_stereo_frames(dut):
     cfg = load_config()
     p = cfg["params"]
     w, h = p["width"], p["height"]
-    share, nms = p.get("share", 3), p.get("nms", 3)
-    blocks = tuple(p.get("blocks", (4, 4)))
+    share, nms = p.get("share", 3), p.get("nms", NMS_DEFAULT)
+    blocks = tuple(p.get("blocks", THRESHOLD_BLOCKS))
     n = blocks[0] * blocks[1]
-    k = tuple(cfg.get("k", (10, 10)))
+    k = tuple(cfg.get("k", (K_CODE_DEFAULT, K_CODE_DEFAULT)))
     thr = cfg.get("thresholds", [[0] * n, [0] * n])
-    Clock(dut.clk, PERIOD_NS, unit="ns").start()
-    dut.thr_we.value = 0
-    dut.thr_cam.value = 0
-    dut.thr_addr.value = 0
-    dut.thr_data.value = 0
-    source = BeatSource(dut, "sink", dut.clk, SpacedIdle(share, cfg.get("duty", 1.0), cfg.get("seed", 0)),
-                        period_ns=PERIOD_NS)
-    dut.rst.value = 1
-    await ClockCycles(dut.clk, 3)
-    dut.rst.value = 0
-    await RisingEdge(dut.clk)
-    await write_registers(dut, dut.clk, k, thr, corner_model.OUT.wl)
-    monitor = BeatMonitor(dut, "source", dut.clk, period_ns=PERIOD_NS)
+    source, monitor = await start_run(dut, share=share, k=k, thresholds=thr, duty=cfg.get("duty", 1.0),
+                                      seed=cfg.get("seed", 0))
 
     pairs = [stereo_pair(s, w, h) for s in cfg.get("frames", ["random:1|random:2"])]
     beats = []

@@ -39,7 +39,8 @@ async def line_delay_stereo_frames(dut):
     beats = []
     cut = frame_beats(rng.integers(0, 1 << bits, (h, w)), stereo=True,
                       right=rng.integers(0, 1 << bits, (h, w)))
-    beats += cut[:min(cfg.get("token_after", 7), len(cut) - 2)] + [TOKEN + (1,)]  # a token with cam = 1 resets both sides
+    # a token with cam = 1 resets both sides
+    beats += cut[:min(cfg.get("token_after", 7), len(cut) - 2)] + [TOKEN + (1,)]
     for left, right in frames:
         beats += frame_beats(left, stereo=True, right=right)
     source.send_beats(beats)

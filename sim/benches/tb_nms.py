@@ -3,6 +3,7 @@
 import cocotb
 
 from eyestereo.sim.lib.bench import StreamTB, run_configured
+from eyestereo.tools.constants import NMS_DEFAULT
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import nms as model
 
@@ -11,7 +12,7 @@ class NmsTB(StreamTB):
     token_spec = "rcorner:99:-3:3"
 
     def expected(self, frame):
-        return model.nms(corner_model.from_word(frame), self.cfg["params"].get("size", 3))
+        return model.nms(corner_model.from_word(frame), self.cfg["params"].get("size", NMS_DEFAULT))
 
 
 @cocotb.test()

@@ -16,17 +16,9 @@ import numpy as np
 from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
 
-from eyestereo.sim.lib.bench import load_config, write_report
+from eyestereo.sim.lib.bench import write_report
+from eyestereo.sim.lib.rectify_bench import random_codes, rectify_config, write_coefficients
 from eyestereo.tools.models import poly_unit as model
-
-
-def calibration(p: dict) -> model.Calibration:
-    return model.Calibration.load(p.get("quantizers", "rig"), source_width=p.get("source_width"),
-                                  source_height=p.get("source_height"))
-
-
-def random_codes(cal: model.Calibration, rng: np.random.Generator) -> list[list[int]]:
-    return [[int(rng.integers(f.lo, f.hi + 1)) for f in cal.formats[:10]] for _ in range(4)]
 
 
 def boundary_points(cal: model.Calibration) -> np.ndarray:
@@ -42,23 +34,10 @@ def boundary_points(cal: model.Calibration) -> np.ndarray:
     return np.concatenate(out) if out else np.zeros((0, 3), dtype=np.int64)
 
 
-async def write_coefficients(dut, clk, writes) -> None:
-    """Drive the coefficient port, one write per clock (inputs change just after a falling edge)."""
-    for addr, data in writes:
-        await FallingEdge(clk)
-        dut.coef_we.value = 1
-        dut.coef_addr.value = addr
-        dut.coef_data.value = data
-    await FallingEdge(clk)
-    dut.coef_we.value = 0
-
-
 @cocotb.test()
 async def poly_unit_random(dut):
-    cfg = load_config()
+    cfg, cal, frac = rectify_config()
     p = cfg["params"]
-    cal = calibration(p)
-    frac = model.resolve_frac(cal, p.get("frac"))
     rng = np.random.default_rng(int(cfg.get("seed", 0)))
     n = int(cfg.get("cycles", 2000))
     en_p, valid_p = float(cfg.get("en_p", 1.0)), float(cfg.get("valid_p", 0.8))

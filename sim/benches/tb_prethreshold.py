@@ -9,6 +9,7 @@ import cocotb
 import numpy as np
 
 from eyestereo.sim.lib.bench import StreamTB, run_configured, write_thresholds
+from eyestereo.tools.constants import THRESHOLD_BLOCKS
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import prethreshold as model
 
@@ -19,7 +20,7 @@ class PrethresholdTB(StreamTB):
     def __init__(self, dut, cfg, **kw):
         super().__init__(dut, cfg, **kw)
         p = cfg["params"]
-        self.blocks = tuple(p.get("blocks", (4, 4)))
+        self.blocks = tuple(p.get("blocks", THRESHOLD_BLOCKS))
         n = self.blocks[0] * self.blocks[1]
         self.written = {int(i): int(v) for i, v in cfg.get("thresholds", {}).items()}
         if cfg.get("reset_after_write"):

@@ -16,7 +16,7 @@ from cocotb.triggers import ClockCycles
 from eyestereo.sim.lib.bench import load_config, write_report
 from eyestereo.sim.lib.stream import UNKNOWN, BeatMonitor
 from eyestereo.tools.models.stream_checker import inject_fault
-from eyestereo.tools.stream import TOKEN, FrameAssembler, frame_to_beats
+from eyestereo.tools.stream import FrameAssembler, frame_to_beats
 
 
 @cocotb.test()

@@ -19,21 +19,14 @@ from __future__ import annotations
 import cocotb
 import numpy as np
 from cocotb.clock import Clock
-from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
+from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge
 
-from eyestereo.sim.lib.bench import load_config, write_report
-from eyestereo.sim.lib.fetch_memory import Clocked, FetchMemory, StereoMonitor, compare_requests, compare_stream
+from eyestereo.sim.lib.bench import write_report
+from eyestereo.sim.lib.fetch_memory import Clocked, StereoMonitor, compare_requests, compare_stream
+from eyestereo.sim.lib.rectify_bench import PERIOD, memory, quiet, rectify_config, reset, wait_beats
 from eyestereo.tools.models import fetch_interpolate as fi_model
 from eyestereo.tools.models import rectifier as model
-from eyestereo.tools.models.poly_unit import Calibration, resolve_frac
-
-PERIOD = 10  # ns
-
-
-def calibration(params: dict) -> Calibration:
-    from eyestereo.hdl.rectify.poly_unit import calibration_param
-
-    return calibration_param(params.get("quantizers", "rig"), params.get("source_width"), params.get("source_height"))
+from eyestereo.tools.models.coordinate_warper import coordinate_warper
 
 
 def load_images(spec, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
@@ -44,44 +37,6 @@ def load_images(spec, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
         rng = np.random.default_rng(int(arg or 1))
         return (rng.integers(0, 256, (h, w), dtype=np.uint8), rng.integers(0, 256, (h, w), dtype=np.uint8))
     raise ValueError(f"unknown image spec {spec!r}")
-
-
-def memory(dut, cfg: dict, images: dict) -> FetchMemory:
-    return FetchMemory(dut, images, seed=int(cfg.get("seed", 1)), ready_p=float(cfg.get("ready_p", 1.0)),
-                       latency=int(cfg.get("latency", 0)), wait_p=float(cfg.get("wait_p", 0.0)),
-                       stall_p=float(cfg.get("stall_p", 0.0)), stall=tuple(cfg.get("stall", (50, 400))))
-
-
-async def reset(dut, clk) -> None:
-    await FallingEdge(clk)
-    dut.rst.value = 1
-    await ClockCycles(clk, 3)
-    await FallingEdge(clk)
-    dut.rst.value = 0
-
-
-async def wait_beats(clk, mon: StereoMonitor, n: int, timeout: int, what: str) -> None:
-    waited = 0
-    while len(mon.beats) < n:
-        await ClockCycles(clk, 256)
-        waited += 256
-        if waited > timeout:
-            raise AssertionError(f"{what}: {len(mon.beats)} of {n} beats after {waited} clocks")
-
-
-async def quiet(dut, clk, mem: FetchMemory, mon: StereoMonitor, busy_name: str = "busy") -> None:
-    """Wait for the memory to drain, then check that nothing more happens."""
-    for _ in range(400):
-        await RisingEdge(clk)
-        await ReadOnly()
-        if mem.idle and not int(getattr(dut, busy_name).value):
-            break
-    assert int(getattr(dut, busy_name).value) == 0, f"{busy_name} still high after the last frame"
-    n_beats, n_req = len(mon.beats), len(mem.requests)
-    await ClockCycles(clk, 300)
-    assert len(mon.beats) == n_beats, f"{len(mon.beats) - n_beats} beats after the last frame"
-    assert len(mem.requests) == n_req, f"{len(mem.requests) - n_req} requests after the last frame"
-    assert mem.idle, f"{len(mem.beats)} responses never delivered"
 
 
 def figures(cal, frac, mon, mem, frames, starts, pairs_oor) -> dict:
@@ -97,10 +52,7 @@ def figures(cal, frac, mon, mem, frames, starts, pairs_oor) -> dict:
 
 @cocotb.test()
 async def rectifier_frames(dut):
-    cfg = load_config()
-    p = cfg["params"]
-    cal = calibration(p)
-    frac = resolve_frac(cal, p.get("frac"))
+    cfg, cal, frac = rectify_config()
     clk = dut.clk
     Clock(clk, PERIOD, unit="ns").start()
     dut.start.value = 0
@@ -132,7 +84,8 @@ async def rectifier_frames(dut):
         await ClockCycles(clk, 5)
         assert not int(dut.busy.value) and not mon.beats, "rst must end the frame"
     starts = []
-    per = 8 + 400 * float(cfg.get("stall_p", 0)) * 100 + 20 * float(cfg.get("wait_p", 0)) + 8 / float(cfg.get("ready_p", 1))
+    per = (8 + 400 * float(cfg.get("stall_p", 0)) * 100 + 20 * float(cfg.get("wait_p", 0))
+           + 8 / float(cfg.get("ready_p", 1)))
     for f in range(frames):
         await FallingEdge(clk)
         dut.start.value = 1
@@ -154,8 +107,6 @@ async def rectifier_frames(dut):
             raise
         bit_exact = False
     compare_requests(mem.request_arrays(), model.requests(cal, frac, frames), "fetch requests")
-    from eyestereo.tools.models.coordinate_warper import coordinate_warper
-
     pr = coordinate_warper(cal, frac)
     oor = (int(pr["oor_l"].sum()) + int(pr["oor_r"].sum())) * frames
     report = figures(cal, frac, mon, mem, frames, starts, oor)

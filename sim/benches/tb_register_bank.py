@@ -31,7 +31,7 @@ from eyestereo.sim.lib.axil import AxiLiteHost
 from eyestereo.sim.lib.bench import load_config, write_report
 from eyestereo.tools.host_driver import BusError, HostDriver
 from eyestereo.tools.models.register_bank import RegisterBank
-from eyestereo.tools.regmap import ARB_WORDS, OKAY, REGMAP, SLVERR
+from eyestereo.tools.regmap import ARB_WORDS, REGMAP
 
 CONTIGUOUS = (0x1, 0x2, 0x4, 0x8, 0x3, 0x6, 0xC, 0x7, 0xE, 0xF)
 
@@ -48,7 +48,8 @@ class TB:
         self.clk = dut.clk
         Clock(dut.clk, 10, unit="ns").start()
         p = cfg["params"]
-        self.model = RegisterBank(width=p.get("width", 352), height=p.get("height", 288))
+        # the bank's frame size, else the model's defaults (the block's)
+        self.model = RegisterBank(**{k: p[k] for k in ("width", "height") if k in p})
         self.salt = 0
         for w in REGMAP.of_kind("window"):
             self.model.windows[w.port] = (lambda i, _p=w.port: window_word(_p, i, self.salt))
@@ -83,7 +84,7 @@ class TB:
                    getattr(self.dut, f"regs_{r.port}_data")) for r in REGMAP.of_kind("array")]
         while True:
             await RisingEdge(self.clk)
-            for p, lat, addr, data, mask in wins:
+            for p, _lat, addr, data, mask in wins:
                 h = hist[p]
                 try:
                     a = int(addr.value)
@@ -202,7 +203,7 @@ async def register_bank_against_table(dut):
     assert len([e for e in tb.events if e[0] == "pulse"]) > 5 and len(tb.events) > 40
 
     # 4. status inputs
-    for rnd in range(3):
+    for _round in range(3):
         for f in list(tb.model.inputs):
             v = rng.getrandbits(tb.model.regmap.field(f)[1].width)
             getattr(dut, f"regs_{f}").value = v

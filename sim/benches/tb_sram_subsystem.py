@@ -30,7 +30,8 @@ from cocotb.triggers import ClockCycles, RisingEdge
 from eyestereo.sim.lib.bench import load_config, write_report
 from eyestereo.sim.lib.sram_agents import CameraSource, FeatureSource, FetchMaster, HostMaster, Pin, StereoSource
 from eyestereo.sim.lib.sram_model import SramModel, read_int
-from eyestereo.tools.models.sram_arbiter import MASTERS, STAT, AddressMap, BufferHistory, fetch_addresses
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
+from eyestereo.tools.models.sram_arbiter import MASTERS, STAT, WRITERS, AddressMap, BufferHistory, fetch_addresses
 from eyestereo.tools.sram import SramPart
 
 PERIOD_NS = 10
@@ -182,10 +183,9 @@ async def subsystem_traffic(dut):
     cfg = load_config()
     p = cfg["params"]
     part = SramPart(p.get("kind", "nobl"), p.get("read_latency", 2))
-    w, h = p.get("width", 352), p.get("height", 288)
+    w, h = p.get("width", FRAME_WIDTH), p.get("height", FRAME_HEIGHT)
     amap = AddressMap(w, h, p.get("feature_words", 8192))
     seed = cfg.get("seed", 1)
-    rng = random.Random(seed)
     clk = dut.clk
     Clock(clk, PERIOD_NS, unit="ns").start()
     for name in ("cam0_valid", "cam1_valid", "fetch_req_valid", "rect_valid", "feat_valid", "host_req_valid",
@@ -246,7 +246,8 @@ async def subsystem_traffic(dut):
         if fetch.held:
             fetch_held_clocks += 1
         if cfg.get("debug") and clock >= cfg["debug"]:
-            g = lambda n: read_int(getattr(dut, "sram_arbiter0_" + n))
+            def g(n):
+                return read_int(getattr(dut, "sram_arbiter0_" + n))
             print("DBG", clock, *[f"{n}={g(n)}" for n in cfg.get("debug_signals", [])], "pend", len(fetch.pending),
                   "held", fetch.held, ctl.held)
         clock += 1
@@ -279,26 +280,25 @@ async def subsystem_traffic(dut):
     await ClockCycles(clk, 64)
     assert model.chip.idle, (f"the SRAM model still has {model.chip.pending()}; last writes "
                              f"{[(e, hex(a), hex(d)) for e, a, d in model.chip.write_log[-6:]]}, clock {clock}; "
-                             f"{sum(1 for e, a, d in model.chip.write_log if a in (4 * amap.frame, 5 * amap.frame))} base writes of {len(model.chip.write_log)}; {stereo.sent[-1][:3]}, {len(stereo.sent)}")
+                             f"{sum(1 for e, a, d in model.chip.write_log if a in (4 * amap.frame, 5 * amap.frame))} "
+                             f"base writes of {len(model.chip.write_log)}; {stereo.sent[-1][:3]}, {len(stereo.sent)}")
     stat = await read_stat(dut, clk)
     assert all(v is not None for v in stat.values()), f"undefined status words: {stat}"
 
     # ---- offline checks against the SRAM's logs ------------------------------------------------------
     wl, rl = model.chip.write_log, model.chip.read_log
-    n = amap.frame
     cap = amap.feature_words
     # (a camera FIFO that overflowed -- allowed only when measuring the margin -- lost words: its frames
     # no longer match what was sent, so the camera data checks are skipped then; everything else holds)
     lossy = any(c.overflows for c in cams)
-    hist = {f"cam{c}": BufferHistory(f"camera {c}", (amap.camera(c, 0), amap.camera(c, 1)), n,
-                                     [] if lossy else wl, cams[c].frames) for c in (0, 1)}
-    hist["rect"] = BufferHistory("rectified", (amap.rectified(0), amap.rectified(1)), n, wl, stereo.sent)
+    # what each writer (MASTER_TABLE's writers, one double buffer each) was given
+    sent = dict(cam0=cams[0].frames, cam1=cams[1].frames, rect=stereo.sent, feat=feats.sent)
 
     def stored_list(lst):
         return list(lst) if len(lst) <= cap else list(lst[:cap - 1]) + [lst[-1]]
 
-    hist["feat"] = BufferHistory("features", (amap.features(0), amap.features(1)), cap, wl, feats.sent,
-                                 stored=stored_list)
+    hist = {k: BufferHistory(k, amap.bases(k), amap.size(k), [] if lossy and k in ("cam0", "cam1") else wl, sent[k],
+                             stored=stored_list if k == "feat" else None) for k in WRITERS}
     regions = {k: [(b, b + hi.size) for b in hi.bases] for k, hi in hist.items()}
 
     def region_of(addr):
@@ -321,7 +321,7 @@ async def subsystem_traffic(dut):
         f"fetch read {i} went to {g:#07x}, the request asks {e:#07x}"
         for i, (g, e) in enumerate(zip([a for _, a in cam_reads] + [None] * len(want), want)) if g != e)
     assert len(fetch.responses) == len(want), f"{len(fetch.responses)} fetch responses for {len(want)} reads"
-    for i, ((e, a), (_, idx, data)) in enumerate(zip(cam_reads, fetch.responses)):
+    for i, ((e, a), (_, _idx, data)) in enumerate(zip(cam_reads, fetch.responses)):
         if lossy:
             break
         k = region_of(a)
@@ -334,14 +334,14 @@ async def subsystem_traffic(dut):
         expect = hist[region_of(a)].word_at(e, a)
         assert data == expect, f"host read of {a:#07x} at edge {e}: {data:#06x}, expected {expect:#06x}"
     # counters
-    moved = {"cam0": writes_by["cam0"], "cam1": writes_by["cam1"], "fetch": len(cam_reads),
-             "rect": writes_by["rect"], "feat": writes_by["feat"], "host": host.accesses}
+    moved = dict(writes_by, fetch=len(cam_reads), host=host.accesses)
     for i, m in enumerate(MASTERS):
-        assert stat[i] == moved[m] & 0xFFFFFFFF, f"status word {i} ({STAT[i]}) is {stat[i]}, the bench counted {moved[m]}"
-    for i, k in enumerate(("cam0", "cam1", "rect", "feat")):
+        assert stat[i] == moved[m] & 0xFFFFFFFF, \
+            f"status word {i} ({STAT[i]}) is {stat[i]}, the bench counted {moved[m]}"
+    for i, k in enumerate(WRITERS):
         if lossy and k in ("cam0", "cam1"):
             continue
-        published = stat[13 + i] & 0xFFFF
+        published = stat[2 * len(MASTERS) + 1 + i] & 0xFFFF
         complete = len(hist[k].complete_runs())
         assert published == complete, f"{k}: {published} frames published, {complete} complete in the SRAM"
     assert stat[19] >> 16 == 0, f"the rectified writer lost {stat[19] >> 16} words"
@@ -360,8 +360,7 @@ async def subsystem_traffic(dut):
         per = {m: 0 for m in MASTERS}
         for e, a, _ in wl:
             if e0 <= e < e1:
-                r = region_of(a)
-                per[{"cam0": "cam0", "cam1": "cam1", "rect": "rect", "feat": "feat", "host": "host"}[r]] += 1
+                per[region_of(a)] += 1
         for e, a in rl:
             if e0 <= e < e1:
                 per["fetch" if region_of(a) in ("cam0", "cam1") else "host"] += 1
@@ -375,10 +374,9 @@ async def subsystem_traffic(dut):
                         cam_max_fill=[c.max_fill for c in cams])
     report = dict(
         clocks=total, edges=st.edges, sram=vars(st), stat={STAT[k]: v for k, v in stat.items()},
-        moved=moved, waited={m: stat[6 + i] for i, m in enumerate(MASTERS)},
+        moved=moved, waited={m: stat[len(MASTERS) + i] for i, m in enumerate(MASTERS)},
         frames={k: len(hist[k].complete_runs()) for k in hist},
-        frames_sent={"cam0": len(cams[0].frames), "cam1": len(cams[1].frames), "rect": len(stereo.sent),
-                     "feat": len(feats.sent)},
+        frames_sent={k: len(sent[k]) for k in WRITERS},
         cam_max_fill=[c.max_fill for c in cams], cam_fifo=cams[0].depth,
         fetch_requests=len(fetch.requests), fetch_reads=len(cam_reads), fetch_held_clocks=fetch_held_clocks,
         fetch_latency=[fetch.first_rsp[i] - fetch.requests[i][0] for i in sorted(fetch.first_rsp)][:2000],

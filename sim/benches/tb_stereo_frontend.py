@@ -45,10 +45,10 @@ from eyestereo.sim.lib.bench import load_config, write_report
 from eyestereo.sim.lib.camera import CameraModel, camera_frame
 from eyestereo.sim.lib.sram_model import SramModel
 from eyestereo.tools.camera import CameraTiming, frame_schedule
+from eyestereo.tools.constants import K_CODE_DEFAULT
 from eyestereo.tools.host_driver import HostDriver
 from eyestereo.tools.models import stereo_frontend as model
 from eyestereo.tools.models.feature_list import parse_words
-from eyestereo.tools.models.harris_mono import k_code
 from eyestereo.tools.models.sram_arbiter import AddressMap
 from eyestereo.tools.regmap import ARB_WORDS
 from eyestereo.tools.sram import SramPart
@@ -112,7 +112,7 @@ def pair_frames(pair, n: int, width: int, height: int) -> list[tuple[np.ndarray,
 
 
 #: The top's parameters that change what the system computes, handed to the model by the bench
-#: (quantizers, the calibration, is handed as ``cal``). The others (share, feature_words, cam_depth, kind,
+#: (quantizers, the calibration, is handed as ``cal``). The others (feature_words, cam_depth, kind,
 #: read_latency, rect_depth) change timing or resources only; ``order`` is the cameras' byte order, which the
 #: camera models send in the default order (YUYV) only.
 MODEL_PARAMS = ("nms", "border", "max_features", "frac")
@@ -151,7 +151,7 @@ def choose_thresholds(cal, frames, k, target: int, mp: dict) -> int:
 @cocotb.test()
 async def frames_bit_exact(dut):
     cfg = load_config()
-    from eyestereo.hdl.rectify.poly_unit import calibration_param
+    from eyestereo.hdl.rectify.calibration import calibration_param
 
     cal = calibration_param(cfg["params"]["quantizers"], None, None)
     w, h = cal.width, cal.height
@@ -168,7 +168,7 @@ async def frames_bit_exact(dut):
     else:
         frames = stereo_frames(cfg.get("images") or "random:1", n_cam, w, h)
     digests = [(frame_digest(a), frame_digest(b)) for a, b in frames]
-    k = k_code(0.04)
+    k = K_CODE_DEFAULT  # k = 0.04, the thesis's (and the K registers' reset)
     thr = cfg["threshold"] if cfg.get("threshold") is not None else \
         choose_thresholds(cal, frames, k, cfg.get("target", 40), mp)
 
@@ -197,7 +197,7 @@ async def frames_bit_exact(dut):
     assert await drv.read_thresholds("THR_LEFT") == [thr] * 16
     await ClockCycles(dut.clk, 50)  # the thresholds cross into the Harris clock
 
-    for c, (cam, idx) in enumerate(zip(cams, (0, 1))):
+    for cam, idx in zip(cams, (0, 1)):
         await cocotb.start(cam.start_clock())
         cocotb.start_soon(cam.play(frame_schedule([f[idx] for f in frames], timing)))
 
@@ -250,7 +250,7 @@ async def frames_bit_exact(dut):
     def find(pred, last, diff=None):
         hits = [(i, j) for i in range(n_cam) for j in range(max(0, i - 1), min(n_cam, i + 2)) if pred(model_of(i, j))]
         if not hits and diff is not None:
-            best = min(((diff(model_of(i, j)), (i, j)) for i in range(n_cam) for j in range(n_cam)))
+            best = min((diff(model_of(i, j)), (i, j)) for i in range(n_cam) for j in range(n_cam))
             raise AssertionError(f"no stereo pair of the frames sent gives what the host read; nearest {best}")
         assert hits, "no stereo pair of the frames sent gives what the host read"
         hits = [p for p in hits if p > last] or hits
@@ -305,9 +305,11 @@ async def frames_bit_exact(dut):
         dut._log.info(f"frame {n}: started {t0 / 1e6:.3f} ms, done {t_frame / 1e6:.3f} ms, read {t_read / 1e6:.3f} ms "
                       f"(simulated), wall {time.time() - wall0:.1f} s")
         await drv.pulse("rect_release", "feat_release")
-        pr = find(lambda m: np.array_equal(m["rect_words"], rect), last_rect,
-                  lambda m: (int(np.sum(m["rect_words"] != rect)), np.argwhere(m["rect_words"] != rect)[:4].tolist()))
-        pl = find(lambda m: m["list_words"] == lw, last_list)
+        # find() calls the predicates at once; the defaults bind this frame's words to them all the same
+        pr = find(lambda m, rect=rect: np.array_equal(m["rect_words"], rect), last_rect,
+                  lambda m, rect=rect: (int(np.sum(m["rect_words"] != rect)),
+                                        np.argwhere(m["rect_words"] != rect)[:4].tolist()))
+        pl = find(lambda m, lw=lw: m["list_words"] == lw, last_list)
         lst = parse_words([(d, False, False) for d in lw[:-1]] + [(lw[-1], True, True)])[0]
         last = dict(rect=rect.tolist(), features=[list(f) for f in lst["features"]])
         ml = model_of(*pl)["list"]  # the model's list of that pair: equal to what the host read
@@ -317,7 +319,7 @@ async def frames_bit_exact(dut):
         last_rect, last_list = pr, pl
         # the totals and per-block counts belong to the last complete frame: the list's pair, or a later
         # one in the overlapped mode (the system goes on meanwhile): it must be one of the frames sent
-        def counts_ok(m):
+        def counts_ok(m, counts=counts, tot=tot):
             c = m["list"]["counts"]
             return [int(x) for x in c[0]] == counts[0] and [int(x) for x in c[1]] == counts[1] and \
                 int(m["list"]["totals"][0]) == tot & 0xFFFF and int(m["list"]["totals"][1]) == tot >> 16

@@ -106,7 +106,8 @@ class CheckerTB:
                        if a != b)
             raise AssertionError(f"{name}: output beat {bad} (cycle, data, eol, eof, cam, error, code) is "
                                  f"{got[bad] if bad < len(got) else None}, the model says "
-                                 f"{want[bad] if bad < len(want) else None} ({len(got)} beats out, {len(want)} expected)")
+                                 f"{want[bad] if bad < len(want) else None} "
+                                 f"({len(got)} beats out, {len(want)} expected)")
         first = next((i for i, s in enumerate(steps) if s.error), None)
         changes = self.monitor.changes
         if first is None:
@@ -134,5 +135,5 @@ async def stream_checker_scenarios(dut):
     assert codes == expected_codes, f"fault codes seen {sorted(codes)}, expected {sorted(expected_codes)}"
     if tb.repair:
         assert sum(r["dropped"] for r in results) > 0, "repair mode dropped no beat"
-    write_report(cfg, dict(scenarios=results, frames=len(results), pixels_compared=sum(r["beats_out"] for r in results)))
-
+    write_report(cfg, dict(scenarios=results, frames=len(results),
+                           pixels_compared=sum(r["beats_out"] for r in results)))

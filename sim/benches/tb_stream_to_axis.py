@@ -16,7 +16,7 @@ from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
 
 from eyestereo.sim.lib.axis import axis_sink, packets_to_beats, pauses
-from eyestereo.sim.lib.bench import load_config, make_frame, write_report
+from eyestereo.sim.lib.bench import frame_params, load_config, make_frame, write_report
 from eyestereo.sim.lib.stream import IdleGenerator, StreamSource
 from eyestereo.tools.models.stream_to_axis import match_frames, split_frames, to_axis
 from eyestereo.tools.stream import frame_to_beats
@@ -67,9 +67,8 @@ class StreamToAxisTB:
 @cocotb.test()
 async def stream_to_axis_frames(dut):
     cfg = load_config()
-    p = cfg["params"]
-    w, h = p["width"], p["height"]
-    bits = p.get("data_width", 8)
+    w, h, bits = frame_params(cfg)
+    commit = cfg["params"].get("commit", "line")
     tb = StreamToAxisTB(dut, cfg)
     await tb.reset()
     frames = [make_frame(s, w, h, bits) for s in cfg["frames"]]
@@ -93,7 +92,7 @@ async def stream_to_axis_frames(dut):
     tw = len(dut.source_tdata)
     assert all(0 <= d < (1 << bits) for d, _, _ in beats), f"tdata bits above the {bits}-bit pixel are set"
     assert len(dut.source_tdata) == 8 * ((bits + 7) // 8), f"tdata is {tw} bits for {bits}-bit pixels"
-    whole, cut = match_frames(sent, received, commit=p.get("commit", "line"))
+    whole, cut = match_frames(sent, received, commit=commit)
     token_cut = [0] if cfg.get("token_after") is not None else []
     if cfg.get("expect", "exact") == "exact":
         assert tb.overflows == 0, f"overflow pulsed {tb.overflows} times"
@@ -102,7 +101,7 @@ async def stream_to_axis_frames(dut):
         # lines (line commit; nothing with frame commit), then every frame whole.
         exp = []
         if token_cut:
-            k = cfg["token_after"] // w if p.get("commit", "line") == "line" else 0
+            k = cfg["token_after"] // w if commit == "line" else 0
             exp += to_axis(sent[0])[:k * w]
         for f in frames:
             exp += to_axis(f)

@@ -1,21 +1,22 @@
 """A MyHDL bench top: the register bank on the real SRAM subsystem (arbiter + controller), wired as in the system.
 
 The bank's ``arb`` window is the arbiter's status port, its SRAM window the arbiter's host port, and the
-host's frame-handshake fields go to the arbiter's :class:`~eyestereo.hdl.memory.frame_buffers.FrameControl` as
-docs/registers.md ("Connections") says: ``rect_want``/``feat_want``/``rect_release``/``feat_release`` out,
-``avail``, ``rect_held``, ``feat_held``, ``rect_buf``, ``feat_buf`` in. Everything else stays a port of
-the top (the masters, the camera side of the frame handshake, the SRAM pins, the other register fields),
-driven by the bench :mod:`eyestereo.sim.benches.tb_host_system`.
+host's frame-handshake fields go to the arbiter's :class:`~eyestereo.hdl.memory.frame_buffers.FrameControl`
+through :func:`~eyestereo.hdl.system.frame_handshake.frame_handshake`, the system top's own wiring
+(docs/registers.md, "Connections"). Everything else stays a port of the top (the masters, the camera side
+of the frame handshake, the SRAM pins, the other register fields), driven by the bench
+:mod:`eyestereo.sim.benches.tb_host_system`.
 
 Registered as the simulation-only catalogue top ``host_system_tb`` (:data:`eyestereo.hdl.flow.catalog.BENCH_TOPS`).
 """
 
 from __future__ import annotations
 
-from myhdl import ResetSignal, Signal, always_comb, block
+from myhdl import ResetSignal, Signal, block
 
 from eyestereo.hdl.interfaces.axil import AxiLite
-from eyestereo.hdl.flow.catalog import BENCH_TOPS, BlockSpec, _masters
+from eyestereo.hdl.flow.catalog import BENCH_TOPS, BlockSpec, masters as _masters
+from eyestereo.hdl.system.frame_handshake import frame_handshake
 from eyestereo.hdl.system.register_bank import RegisterPorts, register_bank
 from eyestereo.hdl.interfaces.sram_bus import HostPort, SramPins, StatPort
 from eyestereo.hdl.memory.sram_subsystem import sram_subsystem
@@ -32,20 +33,7 @@ def host_system_tb(clk, rst, bus, regs, fcount, cam0, cam1, fetch, rect, feat, c
     bank = register_bank(clk, rst, bus, regs, stat, fcount, host, width=width, height=height)
     sub = sram_subsystem(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, sram, width=width,
                          height=height, feature_words=feature_words)
-
-    @always_comb
-    def wiring():
-        ctl.rect_want.next = regs.rect_want
-        ctl.feat_want.next = regs.feat_want
-        ctl.rect_release.next = regs.rect_release
-        ctl.feat_release.next = regs.feat_release
-        regs.avail.next = ctl.avail
-        regs.rect_held.next = ctl.rect_held
-        regs.feat_held.next = ctl.feat_held
-        regs.rect_buf.next = ctl.rect_buf
-        regs.feat_buf.next = ctl.feat_buf
-
-    return bank, sub, wiring
+    return bank, sub, frame_handshake(regs, ctl)
 
 
 def _build(p):

@@ -26,8 +26,9 @@ from __future__ import annotations
 
 from myhdl import ConcatSignal, ResetSignal, Signal, always, always_comb, always_seq, block, concat, intbv
 
-from eyestereo.hdl.flow.catalog import BENCH_TOPS, BlockSpec, _calibration, _POLY_DEFAULTS
+from eyestereo.hdl.flow.catalog import BENCH_TOPS, POLY_DEFAULTS as _POLY_DEFAULTS, BlockSpec
 from eyestereo.hdl.interfaces.coord_pair import CoordPair
+from eyestereo.hdl.rectify.calibration import calibration_of, calibration_param
 from eyestereo.hdl.rectify.coordinate_warper import coordinate_warper
 from eyestereo.hdl.rectify.poly_unit import CoefPort
 from eyestereo.tools.models import coordinate_warper as model
@@ -61,8 +62,6 @@ def coordinate_warper_tb(clk, rst, start, busy, done, ack_p, ack_reg, burst, en_
                          quantizers=None, frac: int | None = unit_model.DEFAULT_FRAC, source_width=None,
                          source_height=None, batch: int = 16):
     """The warper between an LFSR-driven consumer and enable, with a batching recorder (module docstring)."""
-    from eyestereo.hdl.rectify.poly_unit import calibration_param
-
     cal = calibration_param(quantizers, source_width, source_height)
     frac = unit_model.resolve_frac(cal, frac)
     coord = CoordPair(cal.source_width, cal.source_height, frac)
@@ -157,12 +156,13 @@ def coordinate_warper_tb(clk, rst, start, busy, done, ack_p, ack_reg, burst, en_
 
 
 def _build(p):
-    cal = _calibration(p)
+    cal = calibration_of(p)
     pw = pair_bits(cal, unit_model.resolve_frac(cal, p["frac"]))
     b = p["batch"]
     if b < 2:
         raise ValueError(f"parameter batch must be at least 2, got {b}")
-    ports = dict(clk=Signal(bool(0)), rst=ResetSignal(0, active=1, isasync=False), start=Signal(bool(0)), busy=Signal(bool(0)), done=Signal(bool(0)), ack_p=Signal(intbv(0)[9:]),
+    ports = dict(clk=Signal(bool(0)), rst=ResetSignal(0, active=1, isasync=False), start=Signal(bool(0)),
+                 busy=Signal(bool(0)), done=Signal(bool(0)), ack_p=Signal(intbv(0)[9:]),
                  ack_reg=Signal(bool(0)), burst=Signal(bool(0)), en_p=Signal(intbv(0)[9:]),
                  seed=Signal(intbv(0)[32:]), rec_strobe=Signal(bool(0)), rec_data=Signal(intbv(0)[b * pw:]),
                  rec_shift=Signal(intbv(0)[b * pw:]), rec_count=Signal(intbv(0, min=0, max=b)),

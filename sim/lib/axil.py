@@ -47,7 +47,7 @@ class AxiLiteChecker:
 
     def __init__(self, dut, prefix: str, clk, rst, *, period_ns: float = 10.0):
         self.sig = {}
-        for ch, (v, r, payload) in CHANNELS.items():
+        for v, r, payload in CHANNELS.values():
             for name in (v, r) + payload:
                 self.sig[name] = getattr(dut, f"{prefix}_{name}")
         self.clk, self.rst = clk, rst

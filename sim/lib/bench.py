@@ -18,6 +18,8 @@ from cocotb.utils import get_sim_time
 
 from eyestereo.sim.lib.stream import (UNKNOWN, ClockedStreamSink, ClockedStreamSource, IdleGenerator, StreamSink,
                                   StreamSource)
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
+from eyestereo.tools.io import centre_crop
 from eyestereo.tools.stream import frame_to_beats
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -32,7 +34,8 @@ def make_frame(spec: str, width: int, height: int, bits: int = 8) -> np.ndarray:
     """A stimulus frame of stream words.
 
     Images (8-bit): ``random:SEED``, ``ramp``, ``file:NAME`` (from tests/data, centre crop), ``pattern:SEED``
-    and ``checker:SEED`` (the corner test patterns of :mod:`eyestereo.tools.testpattern`, blur 0.5). Random words of other widths: ``random:SEED`` uses ``bits``.
+    and ``checker:SEED`` (the corner test patterns of :mod:`eyestereo.tools.testpattern`, blur 0.5). Random
+    words of other widths: ``random:SEED`` uses ``bits``.
     Inputs for later stages, built with the bit-true models from an image spec after the colon:
     ``sobel:IMG`` (Sobel words), ``window:IMG`` (harris_window words), ``corner:K:IMG`` (cornerness
     words for k code K). Random inputs over a stage's full range: ``grad:SEED:LIM`` (Sobel words with
@@ -51,11 +54,7 @@ def make_frame(spec: str, width: int, height: int, bits: int = 8) -> np.ndarray:
         img = cv2.imread(str(DATA / arg), cv2.IMREAD_GRAYSCALE)
         if img is None:
             raise FileNotFoundError(f"cannot read stimulus image {DATA / arg}")
-        if img.shape[0] < height or img.shape[1] < width:
-            raise ValueError(f"{arg} is {img.shape[1]}x{img.shape[0]}, smaller than {width}x{height}")
-        y0 = (img.shape[0] - height) // 2
-        x0 = (img.shape[1] - width) // 2
-        return img[y0:y0 + height, x0:x0 + width].astype(np.int64)
+        return centre_crop(img, width, height, arg).astype(np.int64)
     if kind in ("pattern", "checker"):
         from eyestereo.tools.testpattern import checkerboard_pattern, corner_pattern
 
@@ -243,6 +242,12 @@ def write_report(cfg: dict, report: dict) -> None:
         Path(cfg["report"]).write_text(json.dumps(report, indent=2) + "\n")
 
 
+def frame_params(cfg: dict) -> tuple[int, int, int]:
+    """A bench config's frame width, height and data bits (the blocks' defaults where it gives none)."""
+    p = cfg["params"]
+    return p.get("width", FRAME_WIDTH), p.get("height", FRAME_HEIGHT), p.get("data_width", 8)
+
+
 async def run_configured(dut, tb_class: type[StreamTB]) -> dict:
     """The body of a block bench: frames, duty, token and parameters from the runner's config."""
     import time
@@ -251,8 +256,7 @@ async def run_configured(dut, tb_class: type[StreamTB]) -> dict:
     # CPU time of the simulator process (the simulator and Python share it): on a shared machine the
     # wall-clock rate follows the load, the CPU-time rate much less (make bench reports both).
     cpu0 = time.process_time()
-    p = cfg["params"]
-    w, h = p.get("width", 352), p.get("height", 288)
+    w, h, _ = frame_params(cfg)
     tb = tb_class(dut, cfg, out_width=w, out_height=h)
     frames = [tb.make_input(spec, w, h) for spec in cfg.get("frames", ["random:1", "random:2"])]
     token_frame = tb.make_input(cfg.get("token_frame", tb.token_spec), w, h)

@@ -22,7 +22,9 @@ from cocotb.clock import Clock
 from cocotb.triggers import Timer
 
 from eyestereo.sim.lib.bench import DATA, make_frame
+from eyestereo.sim.lib.stream import port_handles
 from eyestereo.tools.camera import CameraTiming, run_length, yuv_frame, yuv_from_bgr
+from eyestereo.tools.io import centre_crop
 
 
 def camera_frame(spec: str, width: int, height: int) -> np.ndarray:
@@ -46,10 +48,7 @@ def camera_frame(spec: str, width: int, height: int) -> np.ndarray:
         img = cv2.imread(str(DATA / arg), cv2.IMREAD_COLOR)
         if img is None:
             raise FileNotFoundError(f"cannot read stimulus image {DATA / arg}")
-        if img.shape[0] < height or img.shape[1] < width:
-            raise ValueError(f"{arg} is {img.shape[1]}x{img.shape[0]}, smaller than {width}x{height}")
-        y0, x0 = (img.shape[0] - height) // 2, (img.shape[1] - width) // 2
-        crop = np.ascontiguousarray(img[y0:y0 + height, x0:x0 + width])
+        crop = np.ascontiguousarray(centre_crop(img, width, height, arg))
         return yuv_from_bgr(crop, grey=make_frame(spec, width, height))
     raise ValueError(f"unknown camera frame spec {spec!r}")
 
@@ -70,10 +69,7 @@ class CameraModel:
             raise ValueError(f"camera PCLK period must be an even number of ps, got {period_ps}")
         if phase_ps < period_ps // 2:
             raise ValueError(f"camera phase {phase_ps} ps is less than half a period ({period_ps // 2} ps)")
-        self.pclk = getattr(dut, f"{prefix}_pclk")
-        self.vsync = getattr(dut, f"{prefix}_vsync")
-        self.href = getattr(dut, f"{prefix}_href")
-        self.data = getattr(dut, f"{prefix}_data")
+        self.pclk, self.vsync, self.href, self.data = port_handles(dut, prefix, ("pclk", "vsync", "href", "data"))
         self.timing = timing
         self.period = int(period_ps)
         self.phase = int(phase_ps)

@@ -187,30 +187,35 @@ class Clocked:
                 self.progress.write_text(f"{len(self.monitor.beats)} {self.total}\n")
 
 
-def compare_stream(got: dict, want: dict, width: int, what: str) -> int:
-    """All beats equal, all fields; an AssertionError names the first difference."""
-    n_got, n_want = len(got["data"]), len(want["data"])
+def _first_difference(got: dict, want: dict, fields: tuple[str, ...], what: str, unit: str, where) -> int:
+    """The common part of the comparisons: the first differing record of the fields, in that order
+    (``where(k, field)`` describes record ``k``), then the counts; returns the records compared."""
+    n_got, n_want = len(got[fields[0]]), len(want[fields[0]])
     n = min(n_got, n_want)
-    for f in ("cam", "eol", "eof", "data"):
+    for f in fields:
         bad = np.nonzero(got[f][:n] != want[f][:n])[0]
         if len(bad):
-            k = int(bad[0])
-            px = k // 2
-            raise AssertionError(f"{what}: {len(bad)} beats differ in {f}; first: beat {k} (pixel ({px % width}, "
-                                 f"{px // width}), cam {k % 2}): got {int(got[f][k])}, expected {int(want[f][k])}")
-    assert n_got == n_want, f"{what}: {n_got} beats out, {n_want} expected"
+            raise AssertionError(f"{what}: {len(bad)} {unit} differ in {f}; first: {where(int(bad[0]), f)}")
+    assert n_got == n_want, f"{what}: {n_got} {unit}, {n_want} expected by the model"
     return n
+
+
+def compare_stream(got: dict, want: dict, width: int, what: str) -> int:
+    """All beats equal, all fields; an AssertionError names the first difference."""
+
+    def where(k: int, f: str) -> str:
+        px = k // 2
+        return (f"beat {k} (pixel ({px % width}, {px // width}), cam {k % 2}): got {int(got[f][k])}, "
+                f"expected {int(want[f][k])}")
+
+    return _first_difference(got, want, ("cam", "eol", "eof", "data"), what, "beats", where)
 
 
 def compare_requests(got: dict, want: dict, what: str) -> int:
-    n_got, n_want = len(got["x"]), len(want["x"])
-    n = min(n_got, n_want)
-    for f in ("cam", "x", "y", "mask"):
-        bad = np.nonzero(got[f][:n] != want[f][:n])[0]
-        if len(bad):
-            k = int(bad[0])
-            raise AssertionError(f"{what}: {len(bad)} requests differ in {f}; first: request {k}: got "
-                                 f"{[int(got[g][k]) for g in ('x', 'y', 'cam', 'mask')]}, expected "
-                                 f"{[int(want[g][k]) for g in ('x', 'y', 'cam', 'mask')]}")
-    assert n_got == n_want, f"{what}: {n_got} requests, {n_want} expected by the model"
-    return n
+    """All requests equal (x, y, cam, mask); an AssertionError names the first difference."""
+    fields = ("x", "y", "cam", "mask")
+
+    def where(k: int, f: str) -> str:
+        return f"request {k}: got {[int(got[g][k]) for g in fields]}, expected {[int(want[g][k]) for g in fields]}"
+
+    return _first_difference(got, want, ("cam", "x", "y", "mask"), what, "requests", where)

@@ -24,15 +24,16 @@ from cocotb.triggers import First, RisingEdge, Timer
 from cocotb.utils import get_sim_time
 
 from eyestereo.hdl.flow.convert import vhdl_ports
-from eyestereo.sim.lib.stream import UNKNOWN, IdleGenerator, SinkResults
-from eyestereo.tools.stream import TOKEN, FrameAssembler, ProtocolError, frame_to_beats
+from eyestereo.sim.lib.stream import UNKNOWN, BeatQueue, EdgeTime, IdleGenerator, SinkResults
+from eyestereo.tools.stream import TOKEN
 
 STIM, SENT, CAPT = "hb_stim.txt", "hb_sent.txt", "hb_capt.txt"
 STREAM = ("data", "valid", "eol", "eof")
 
 
-def wrapper_name(block: str) -> str:
-    return f"{block}_hb"
+def _bits(text: str) -> int:
+    """A recorded bit string as an int, UNKNOWN if it holds anything but 0 and 1."""
+    return int(text, 2) if set(text) <= {"0", "1"} else UNKNOWN
 
 
 def _width(vtype: str) -> int:
@@ -160,33 +161,18 @@ end architecture player;
     return path, win
 
 
-class _Clock:
-    """Cycle numbers as the Python drivers count them: rising edge 1 is the first after start-up."""
+def _edge_time(clk) -> EdgeTime:
+    """Cycle numbers in ns as the Python drivers count them: rising edge 1 is the first after start-up."""
+    import cocotb
 
-    def __init__(self, clk):
-        self.t1: int | None = None
-        self.period: int | None = None
-        import cocotb
-
-        cocotb.start_soon(self._learn(clk))
-
-    async def _learn(self, clk):
-        await RisingEdge(clk)
-        self.t1 = int(get_sim_time(unit="ns"))
-        await RisingEdge(clk)
-        self.period = int(get_sim_time(unit="ns")) - self.t1
-
-    def cycle(self, t: int | None = None) -> int:
-        if self.t1 is None:
-            return 0
-        t = int(get_sim_time(unit="ns")) if t is None else t
-        if self.period is None:
-            return 1
-        return (t - self.t1) // self.period + 1
+    time = EdgeTime(unit="ns")
+    cocotb.start_soon(time.learn(RisingEdge(clk)))
+    return time
 
 
-class HdlStreamSource:
-    """The queue side of the player: beats are collected, then written to the stimulus file at once."""
+class HdlStreamSource(BeatQueue):
+    """The queue side of the player: beats are collected, then written to the stimulus file at once.
+    ``idle_now``: nothing left to hand to the player (whether it has played everything is ``hb_done``)."""
 
     def __init__(self, dut, clk, idle: IdleGenerator | None = None):
         self.dut = dut
@@ -194,7 +180,7 @@ class HdlStreamSource:
         self.idle = idle or IdleGenerator()
         self.queue: list = []
         self.sent_cycles: list[int] = []
-        self.time = _Clock(clk)
+        self.time = _edge_time(clk)
         self.started = False
         dut.hb_start.value = 0
         dut.hb_stop.value = 0
@@ -202,20 +188,6 @@ class HdlStreamSource:
     @property
     def cycle(self) -> int:
         return self.time.cycle()
-
-    def send_frame(self, frame) -> None:
-        self.queue.extend(frame_to_beats(frame))
-
-    def send_beats(self, beats) -> None:
-        self.queue.extend(beats)
-
-    def send_token(self) -> None:
-        self.queue.append(TOKEN)
-
-    @property
-    def idle_now(self) -> bool:
-        """Nothing left to hand to the player (whether it has played everything is ``hb_done``)."""
-        return not self.queue
 
     def start(self, width: int) -> None:
         """Write the queued beats (idle cycles drawn now, one draw per cycle) and start the player."""
@@ -240,11 +212,8 @@ class HdlStreamSink(SinkResults):
 
     def __init__(self, dut, clk, width: int, height: int):
         self.dut = dut
-        self.asm = FrameAssembler(width, height)
-        self.received_cycles: list[int] = []
-        self.beats = 0
-        self.error: ProtocolError | None = None
-        self.time = _Clock(clk)
+        self._start(width, height)
+        self.time = _edge_time(clk)
         dut.hb_active.value = 0
 
     @property
@@ -259,10 +228,6 @@ class HdlStreamSink(SinkResults):
     def cycle(self) -> int:
         return self.time.cycle()
 
-    def _fail(self, msg: str) -> None:
-        if self.error is None:
-            self.error = ProtocolError(msg)
-
     def collect(self) -> None:
         """Rebuild the frames from the recording, with StreamSink's checks, beat by beat."""
         for line in Path(CAPT).read_text().splitlines():
@@ -272,16 +237,7 @@ class HdlStreamSink(SinkResults):
             if v != "1":
                 self._fail(f"source_valid is {v} at cycle {cycle}")
                 continue
-            d = int(data, 2) if set(data) <= {"0", "1"} else UNKNOWN
-            self.beats += 1
-            self.received_cycles.append(cycle)
-            if self.error is None:
-                try:
-                    if e not in "01" or f not in "01":
-                        raise ProtocolError(f"eol/eof undefined ({e}, {f})")
-                    self.asm.push(d, e == "1", f == "1")
-                except (ProtocolError, ValueError) as err:
-                    self._fail(f"cycle {cycle}: {err}")
+            self._push(cycle, _bits(data), _bits(e), _bits(f), lambda e=e, f=f: f"{e}, {f}")
 
 
 async def wait_frames_hdl(tb, n: int, timeout_cycles: int) -> None:

@@ -19,6 +19,7 @@ from cocotb.clock import Clock
 from cocotb.simtime import get_sim_time
 from cocotb.triggers import RisingEdge, Timer
 
+from eyestereo.sim.lib.stream import STREAM_PORTS, port_handles, resolved
 from eyestereo.tools.models.async_fifo import ClockSpec
 
 
@@ -79,20 +80,12 @@ class QueueMonitor:
     """
 
     def __init__(self, dut, prefix: str, clock: EdgeClock, ignore=()):
-        self.valid = getattr(dut, f"{prefix}_valid")
-        self.ready = getattr(dut, f"{prefix}_ready")
-        self.data = getattr(dut, f"{prefix}_data")
-        self.eol = getattr(dut, f"{prefix}_eol")
-        self.eof = getattr(dut, f"{prefix}_eof")
+        self.data, self.valid, self.eol, self.eof, self.ready = port_handles(dut, prefix, (*STREAM_PORTS, "ready"))
         self.clock = clock
         self.ignore = list(ignore)
         self.beats: list[tuple[int, bool, bool, int]] = []
         self.undefined: list[str] = []
         self.wakes = 0
-
-    @staticmethod
-    def _bit(v) -> int:
-        return int(v) if v.is_resolvable else -1
 
     async def run(self) -> None:
         clk = self.clock.signal
@@ -100,24 +93,24 @@ class QueueMonitor:
             await RisingEdge(clk)
             self.wakes += 1
             # Right after the edge the signals still hold the values the edge sampled.
-            v, r = self._bit(self.valid.value), self._bit(self.ready.value)
+            v, r = resolved(self.valid.value), resolved(self.ready.value)
             k = self.clock.edge_now()
             if v == 1 and r == 1 and not any(a <= k < b for a, b in self.ignore):
                 raw = self.data.value
-                d = int(raw) if raw.is_resolvable else -1
-                if d < 0 or self._bit(self.eol.value) < 0 or self._bit(self.eof.value) < 0:
+                d = resolved(raw)
+                if d < 0 or resolved(self.eol.value) < 0 or resolved(self.eof.value) < 0:
                     self.undefined.append(f"edge {k}: data {raw} eol {self.eol.value} eof {self.eof.value}")
-                self.beats.append((d, bool(self._bit(self.eol.value) == 1), bool(self._bit(self.eof.value) == 1),
+                self.beats.append((d, bool(resolved(self.eol.value) == 1), bool(resolved(self.eof.value) == 1),
                                    k))
             elif v == -1:
                 self.undefined.append(f"edge {k}: valid {self.valid.value}")
             # Sleep until a word can move: valid high (it is registered: it rises after an edge) and
             # ready high (driven between edges). The values read here are still the pre-edge ones, so at
             # worst this wakes once more than needed.
-            if self._bit(self.valid.value) != 1:
+            if resolved(self.valid.value) != 1:
                 await RisingEdge(self.valid)
                 self.wakes += 1
-            elif self._bit(self.ready.value) != 1:
+            elif resolved(self.ready.value) != 1:
                 await RisingEdge(self.ready)
                 self.wakes += 1
 
@@ -126,15 +119,10 @@ class BeatPlayer:
     """Plays ``(data, eol, eof, edge)`` beats on ``<prefix>_data/valid/eol/eof``: beat at edge k."""
 
     def __init__(self, dut, prefix: str, clock: EdgeClock):
-        self.data = getattr(dut, f"{prefix}_data")
-        self.valid = getattr(dut, f"{prefix}_valid")
-        self.eol = getattr(dut, f"{prefix}_eol")
-        self.eof = getattr(dut, f"{prefix}_eof")
+        self.data, self.valid, self.eol, self.eof = port_handles(dut, prefix)
         self.clock = clock
-        self.valid.value = 0
-        self.data.value = 0
-        self.eol.value = 0
-        self.eof.value = 0
+        for h in (self.valid, self.data, self.eol, self.eof):
+            h.value = 0
 
     async def play(self, beats) -> None:
         last = None

@@ -21,7 +21,6 @@ import os
 import re
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 from cocotb_tools.runner import get_results, get_runner
@@ -303,7 +302,7 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
     build_dir.mkdir(parents=True)
     if waves is None:
         waves = os.environ.get("WAVES", "0") not in ("", "0")
-    full = dict(config, block=block, params=_jsonable(params), report=str(build_dir / "report.json"), sim=sim)
+    full = dict(config, block=block, params=jsonable(params), report=str(build_dir / "report.json"), sim=sim)
     env = {"EYESTEREO_TB": json.dumps(full),
            "PYTHONPATH": os.pathsep.join([str(SIM_DIR), os.environ.get("PYTHONPATH", "")])}
     logs = {} if log_file is None else dict(log_file=str(Path(log_file).with_suffix(".build.log")))
@@ -414,7 +413,8 @@ def simulator_versions() -> dict[str, str]:
     return {k: v for k, v in out.items() if v}
 
 
-def _jsonable(p: dict) -> dict:
+def jsonable(p: dict) -> dict:
+    """A bench's parameters for its JSON config: numpy arrays and tuples as lists (shared with sram_runner)."""
     import numpy as np
 
     return {k: (np.asarray(v).tolist() if isinstance(v, (np.ndarray, tuple)) else v) for k, v in p.items()}

@@ -11,8 +11,6 @@ from __future__ import annotations
 import random
 from collections import deque
 
-import numpy as np
-
 from eyestereo.sim.lib.sram_model import read_int
 from eyestereo.tools.models.sram_arbiter import FETCH_OFFSETS
 
@@ -34,6 +32,13 @@ class Pin:
 
 def port(dut, prefix, *names):
     return [getattr(dut, f"{prefix}_{n}") for n in names]
+
+
+def offer(valid: Pin, pins, values) -> None:
+    """Drive a beat or request: each of ``pins`` to its value, then ``valid`` high."""
+    for pin, v in zip(pins, values, strict=True):
+        pin.set(v)
+    valid.set(1)
 
 
 # ------------------------------------------------------------------------------------------------------
@@ -117,11 +122,7 @@ class CameraSource:
     def drive(self, clock: int) -> None:
         self.arrive(clock)
         if self.fifo:
-            d, eol, eof = self.fifo[0]
-            self.data.set(d)
-            self.eol.set(eol)
-            self.eof.set(eof)
-            self.valid.set(1)
+            offer(self.valid, (self.data, self.eol, self.eof), self.fifo[0])
             self.offered = True
         else:
             self.valid.set(0)
@@ -166,12 +167,7 @@ class StereoSource:
         if not self.beats and self.enabled and (self.limit is None or len(self.sent) < self.limit):
             self._queue_frame()
         if self.beats and self.rng.random() < self.duty:
-            d, cam, eol, eof = self.beats.popleft()
-            self.data.set(d)
-            self.cam.set(cam)
-            self.eol.set(eol)
-            self.eof.set(eof)
-            self.valid.set(1)
+            offer(self.valid, (self.data, self.cam, self.eol, self.eof), self.beats.popleft())
         else:
             self.valid.set(0)
 
@@ -210,10 +206,7 @@ class FeatureSource:
             return  # hold the offered word until it moves
         if self.words and self.rng.random() < self.duty:
             w, last = self.words[0]
-            self.data.set(w)
-            self.eof.set(last)
-            self.eol.set(0)
-            self.valid.set(1)
+            offer(self.valid, (self.data, self.eof, self.eol), (w, last, 0))
             self.offered = True
         else:
             self.valid.set(0)
@@ -314,12 +307,7 @@ class FetchMaster:
             self.valid.set(0)
             return
         self.offer = r
-        x, y, c, m = r
-        self.x.set(x)
-        self.y.set(y)
-        self.cam.set(c)
-        self.mask.set(m)
-        self.valid.set(1)
+        offer(self.valid, (self.x, self.y, self.cam, self.mask), r)
 
     @property
     def idle(self) -> bool:
@@ -399,20 +387,12 @@ class HostMaster:
         else:
             self.valid.set(0)
             return
-        we, addr, data, be, _ = self.offer
-        self.we.set(we)
-        self.addr.set(addr)
-        self.wdata.set(data)
-        self.be.set(be)
-        self.valid.set(1)
+        offer(self.valid, (self.we, self.addr, self.wdata, self.be), self.offer[:4])
 
     @property
     def idle(self) -> bool:
         return self.offer is None and not self.jobs and not self.expect
 
 
-def frame_words(frames: list[list[int]]) -> list[np.ndarray]:
-    return [np.asarray(f, dtype=np.int64) for f in frames]
-
-
-__all__ = ["Pin", "CameraSource", "StereoSource", "FeatureSource", "FetchMaster", "HostMaster", "FETCH_OFFSETS"]
+__all__ = ["Pin", "offer", "CameraSource", "StereoSource", "FeatureSource", "FetchMaster", "HostMaster",
+           "FETCH_OFFSETS"]

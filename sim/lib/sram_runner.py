@@ -14,7 +14,7 @@ import os
 import shutil
 from pathlib import Path
 
-from eyestereo.sim.lib.runner import BUILD, SIM_DIR, _jsonable, run_bench, slug
+from eyestereo.sim.lib.runner import BUILD, SIM_DIR, jsonable, run_bench, slug
 
 
 def run_sram_bench(block: str, bench: str, config: dict, *, name: str, params: dict | None = None,
@@ -43,7 +43,7 @@ def _run_icarus(block, bench, config, *, name, params, build_root):
         shutil.rmtree(build_dir)
     build_dir.mkdir(parents=True)
     sources = convert(block, build_dir, hdl="Verilog", **params)
-    full = dict(config, block=block, params=_jsonable(params), report=str(build_dir / "report.json"), sim="icarus")
+    full = dict(config, block=block, params=jsonable(params), report=str(build_dir / "report.json"), sim="icarus")
     env = {"EYESTEREO_TB": json.dumps(full),
            "PYTHONPATH": os.pathsep.join([str(SIM_DIR), os.environ.get("PYTHONPATH", "")])}
     runner = get_runner("icarus")

@@ -16,6 +16,17 @@ from cocotb.utils import get_sim_time
 from eyestereo.tools.stream import TOKEN, FrameAssembler, ProtocolError, frame_to_beats
 
 UNKNOWN = -1  # data read back as X/U/Z (allowed only where a block's output is unspecified)
+STREAM_PORTS = ("data", "valid", "eol", "eof")
+
+
+def resolved(value) -> int:
+    """A value read from a handle (a LogicArray) as an int, UNKNOWN when a bit is not 0 or 1."""
+    return int(value) if value.is_resolvable else UNKNOWN
+
+
+def port_handles(dut, prefix: str, names=STREAM_PORTS) -> list:
+    """The DUT's ``<prefix>_<name>`` handles, in the order of ``names`` (an image stream's by default)."""
+    return [getattr(dut, f"{prefix}_{name}") for name in names]
 
 
 def int_reader(handle):
@@ -27,8 +38,7 @@ def int_reader(handle):
     raw = getattr(getattr(handle, "_handle", None), "get_signal_val_binstr", None)
     if raw is None:  # not a simulator signal handle as cocotb 2.1 has it: the public way
         def public():
-            v = handle.value
-            return int(v) if v.is_resolvable else UNKNOWN
+            return resolved(handle.value)
 
         return public
 
@@ -54,20 +64,28 @@ class IdleGenerator:
         return self.duty >= 1.0 or self.rng.random() < self.duty
 
 
-class _EdgeTime:
+class EdgeTime:
     """Cycle numbers from simulation time: rising edge 1 is the first one a driver saw, ``period`` apart.
 
-    The drivers learn the period from their first two rising edges and from then on sleep across
-    stretches where nothing happens, so they count cycles from the time instead of edge by edge.
+    The drivers learn the period from their first two rising edges (:meth:`learn`) and from then on
+    sleep across stretches where nothing happens, so they count cycles from the time instead of edge by
+    edge. Times are in ``unit`` (simulator steps by default; the HDL drivers' files hold ns).
     """
 
-    def __init__(self):
+    def __init__(self, unit: str = "step"):
+        self.unit = unit
         self.t1: int | None = None
         self.period: int | None = None
 
-    @staticmethod
-    def now() -> int:
-        return get_sim_time(unit="step")
+    def now(self) -> int:
+        return int(get_sim_time(unit=self.unit))
+
+    async def learn(self, edge) -> None:
+        """Wait for rising edges 1 and 2 (``edge``: the clock's RisingEdge) and take t1 and the period."""
+        await edge
+        self.t1 = self.now()
+        await edge
+        self.period = self.now() - self.t1
 
     def cycle(self, t: int | None = None) -> int:
         """Rising edges seen up to time ``t`` (now by default)."""
@@ -79,7 +97,41 @@ class _EdgeTime:
         return (t - self.t1) // self.period + 1
 
 
-class StreamSource:
+class BeatQueue:
+    """The queue side every stream source shares: beats wait in ``queue`` until the source drives them."""
+
+    queue: deque | list
+
+    def send_frame(self, frame) -> None:
+        self.send_beats(frame_to_beats(frame))
+
+    def send_beats(self, beats) -> None:
+        self.queue.extend(beats)
+        self._queued()
+
+    def send_token(self) -> None:
+        self.send_beats([TOKEN])
+
+    def _queued(self) -> None:
+        """Called after beats were queued: a source that sleeps on an empty queue wakes here."""
+
+    @property
+    def idle_now(self) -> bool:
+        """Nothing queued any more."""
+        return not self.queue
+
+    def _drive(self, dut, prefix: str, clk, idle: IdleGenerator | None) -> None:
+        """Take the ``<prefix>_*`` stream ports (all driven to 0), the clock and the idle generator."""
+        self.clk = clk
+        self.data, self.valid, self.eol, self.eof = port_handles(dut, prefix)
+        for h in (self.valid, self.data, self.eol, self.eof):
+            h.value = 0
+        self.idle = idle or IdleGenerator()
+        self.queue = deque()
+        self.sent_cycles: list[int] = []  # cycle number of every beat sent
+
+
+class StreamSource(BeatQueue):
     """Drives ``<prefix>_data/valid/eol/eof`` of a DUT from a queue of beats, with idle cycles.
 
     The beat of cycle n is written at the falling edge in the middle of cycle n, and the DUT samples it
@@ -93,21 +145,10 @@ class StreamSource:
     """
 
     def __init__(self, dut, prefix: str, clk, idle: IdleGenerator | None = None):
-        self.clk = clk
-        self.data = getattr(dut, f"{prefix}_data")
-        self.valid = getattr(dut, f"{prefix}_valid")
-        self.eol = getattr(dut, f"{prefix}_eol")
-        self.eof = getattr(dut, f"{prefix}_eof")
-        self.idle = idle or IdleGenerator()
-        self.queue: deque = deque()
-        self.sent_cycles: list[int] = []  # cycle number of every beat sent
-        self.time = _EdgeTime()
+        self._drive(dut, prefix, clk, idle)
+        self.time = EdgeTime()
         self.changed = Event()
         self._more = Event()
-        self.valid.value = 0
-        self.data.value = 0
-        self.eol.value = 0
-        self.eof.value = 0
         self._task = cocotb.start_soon(self._run())
 
     @property
@@ -115,28 +156,13 @@ class StreamSource:
         """Rising edges since the source started."""
         return self.time.cycle()
 
-    def send_frame(self, frame) -> None:
-        self.queue.extend(frame_to_beats(frame))
+    def _queued(self) -> None:
         self._more.set()
-
-    def send_beats(self, beats) -> None:
-        self.queue.extend(beats)
-        self._more.set()
-
-    def send_token(self) -> None:
-        self.queue.append(TOKEN)
-        self._more.set()
-
-    @property
-    def idle_now(self) -> bool:
-        return not self.queue
 
     async def _run(self):
         edge, fall = RisingEdge(self.clk), FallingEdge(self.clk)
-        await edge
-        self.time.t1 = self.time.now()
-        await edge
-        self.time.period = period = self.time.now() - self.time.t1
+        await self.time.learn(edge)
+        period = self.time.period
         await fall
         valid = eol = eof = 0
         while True:  # at a falling edge: what is written now, the DUT samples at the next rising edge
@@ -171,10 +197,43 @@ class StreamSource:
 
 class SinkResults:
     """What every stream sink gives its bench: the frames and events it assembled (``asm``, a
-    FrameAssembler) and the first protocol error it saw (``error``), raised by :meth:`check`."""
+    FrameAssembler) and the first protocol error it saw (``error``), raised by :meth:`check`; and what
+    every sink does with a beat (:meth:`_push`). ``changed`` (an Event, if the sink has one) is set on
+    the first protocol error."""
 
     asm: FrameAssembler
     error: ProtocolError | None
+    changed: Event | None = None
+
+    def _start(self, width: int, height: int) -> None:
+        self.asm = FrameAssembler(width, height)
+        self.received_cycles: list[int] = []
+        self.beats = 0
+        self.error = None
+
+    def _fail(self, msg: str) -> None:
+        if self.error is None:
+            self.error = ProtocolError(msg)
+            if self.changed is not None:
+                self.changed.set()
+
+    def _shown(self) -> str:
+        """How the ``eol`` and ``eof`` handles read now."""
+        return f"{self.eol.value}, {self.eof.value}"
+
+    def _push(self, cycle: int, data: int, eol: int, eof: int, shown=None) -> None:
+        """One valid beat of ``cycle``: counted, and handed to the frame assembler while no error was
+        seen. ``eol`` / ``eof`` are 0, 1 or UNKNOWN (an error); ``shown()`` tells how they read then
+        (:meth:`_shown` by default)."""
+        self.beats += 1
+        self.received_cycles.append(cycle)
+        if self.error is None:
+            try:
+                if eol == UNKNOWN or eof == UNKNOWN:
+                    raise ProtocolError(f"eol/eof undefined ({(shown or self._shown)()})")
+                self.asm.push(data, bool(eol), bool(eof))
+            except (ProtocolError, ValueError) as err:
+                self._fail(f"cycle {cycle}: {err}")
 
     @property
     def frames(self):
@@ -205,15 +264,9 @@ class StreamSink(SinkResults):
 
     def __init__(self, dut, prefix: str, clk, width: int, height: int):
         self.clk = clk
-        self.data = getattr(dut, f"{prefix}_data")
-        self.valid = getattr(dut, f"{prefix}_valid")
-        self.eol = getattr(dut, f"{prefix}_eol")
-        self.eof = getattr(dut, f"{prefix}_eof")
-        self.asm = FrameAssembler(width, height)
-        self.received_cycles: list[int] = []
-        self.beats = 0
-        self.error: ProtocolError | None = None
-        self.time = _EdgeTime()
+        self.data, self.valid, self.eol, self.eof = port_handles(dut, prefix)
+        self._start(width, height)
+        self.time = EdgeTime()
         self.changed = Event()
         self.active = False  # set once the DUT is out of reset: before that its outputs are undefined
         self._task = cocotb.start_soon(self._run())
@@ -223,20 +276,10 @@ class StreamSink(SinkResults):
         """Rising edges since the sink started."""
         return self.time.cycle()
 
-    def _fail(self, msg: str) -> None:
-        if self.error is None:
-            self.error = ProtocolError(msg)
-            self.changed.set()
-
     async def _run(self):
-        edge = RisingEdge(self.clk)
         fall = FallingEdge(self.clk)
         valid, data, eol, eof = (int_reader(h) for h in (self.valid, self.data, self.eol, self.eof))
-        await edge
-        self.time.t1 = self.time.now()
-        await edge
-        self.time.period = self.time.now() - self.time.t1
-        asm = self.asm
+        await self.time.learn(RisingEdge(self.clk))
         while True:
             await fall
             if not self.active:
@@ -248,56 +291,22 @@ class StreamSink(SinkResults):
             if not v:
                 await self.valid.value_change  # rises (or turns undefined) in a later cycle
                 continue
-            d = data()
-            cycle = self.time.cycle()
-            self.beats += 1
-            self.received_cycles.append(cycle)
-            if self.error is None:
-                e, f = eol(), eof()
-                try:
-                    if e == UNKNOWN or f == UNKNOWN:
-                        raise ProtocolError(f"eol/eof undefined ({self.eol.value}, {self.eof.value})")
-                    asm.push(d, bool(e), bool(f))
-                except (ProtocolError, ValueError) as err:
-                    self._fail(f"cycle {cycle}: {err}")
-                if f == 1:
-                    self.changed.set()
+            f = eof()
+            self._push(self.time.cycle(), data(), eol(), f)
+            if f == 1 and self.error is None:
+                self.changed.set()
 
 
-class ClockedStreamSource:
+class ClockedStreamSource(BeatQueue):
     """The cycle-by-cycle source the benches used before :class:`StreamSource` (Python on every clock).
 
     Kept so ``make bench`` can measure both in one run (bench config ``drivers="clocked"``).
     """
 
     def __init__(self, dut, prefix: str, clk, idle: IdleGenerator | None = None):
-        self.clk = clk
-        self.data = getattr(dut, f"{prefix}_data")
-        self.valid = getattr(dut, f"{prefix}_valid")
-        self.eol = getattr(dut, f"{prefix}_eol")
-        self.eof = getattr(dut, f"{prefix}_eof")
-        self.idle = idle or IdleGenerator()
-        self.queue: deque = deque()
-        self.sent_cycles: list[int] = []  # cycle number of every beat sent
+        self._drive(dut, prefix, clk, idle)
         self.cycle = 0
-        self.valid.value = 0
-        self.data.value = 0
-        self.eol.value = 0
-        self.eof.value = 0
         self._task = cocotb.start_soon(self._run())
-
-    def send_frame(self, frame) -> None:
-        self.queue.extend(frame_to_beats(frame))
-
-    def send_beats(self, beats) -> None:
-        self.queue.extend(beats)
-
-    def send_token(self) -> None:
-        self.queue.append(TOKEN)
-
-    @property
-    def idle_now(self) -> bool:
-        return not self.queue
 
     async def _run(self):
         while True:
@@ -326,18 +335,11 @@ class ClockedStreamSink(SinkResults):
 
     def __init__(self, dut, prefix: str, clk, width: int, height: int):
         self.clk = clk
-        self.data = getattr(dut, f"{prefix}_data")
-        self.valid = getattr(dut, f"{prefix}_valid")
-        self.eol = getattr(dut, f"{prefix}_eol")
-        self.eof = getattr(dut, f"{prefix}_eof")
-        self.asm = FrameAssembler(width, height)
-        self.received_cycles: list[int] = []
-        self.beats = 0
-        self.error: ProtocolError | None = None
+        self.data, self.valid, self.eol, self.eof = port_handles(dut, prefix)
+        self._start(width, height)
         self.cycle = 0
         self.active = False  # set once the DUT is out of reset: before that its outputs are undefined
         self._task = cocotb.start_soon(self._run())
-
 
     async def _run(self):
         while True:
@@ -347,19 +349,10 @@ class ClockedStreamSink(SinkResults):
             if not self.active:
                 continue
             if not self.valid.value.is_resolvable:
-                self.error = self.error or ProtocolError(f"source_valid is {self.valid.value} at cycle {self.cycle}")
+                self._fail(f"source_valid is {self.valid.value} at cycle {self.cycle}")
                 continue
-            if not int(self.valid.value):
-                continue
-            raw = self.data.value
-            data = int(raw) if raw.is_resolvable else UNKNOWN
-            self.beats += 1
-            self.received_cycles.append(self.cycle)
-            if self.error is None:
-                try:
-                    self.asm.push(data, bool(int(self.eol.value)), bool(int(self.eof.value)))
-                except (ProtocolError, ValueError) as e:
-                    self.error = ProtocolError(f"cycle {self.cycle}: {e}")
+            if int(self.valid.value):
+                self._push(self.cycle, resolved(self.data.value), resolved(self.eol.value), resolved(self.eof.value))
 
 
 class BeatSource(StreamSource):
@@ -408,10 +401,7 @@ class BeatMonitor:
     def __init__(self, dut, prefix: str, clk, *, extra: tuple[str, ...] = (), period_ns: float = 10):
         self.clk = clk
         self.period_ns = period_ns
-        self.valid = getattr(dut, f"{prefix}_valid")
-        self.data = getattr(dut, f"{prefix}_data")
-        self.eol = getattr(dut, f"{prefix}_eol")
-        self.eof = getattr(dut, f"{prefix}_eof")
+        self.data, self.valid, self.eol, self.eof = port_handles(dut, prefix)
         self.cam = getattr(dut, f"{prefix}_cam", None)
         self.extra = {name: getattr(dut, name) for name in extra}
         self.beats: list[tuple] = []
@@ -426,16 +416,12 @@ class BeatMonitor:
 
         return int(get_sim_time(unit="ns") // self.period_ns)
 
-    @staticmethod
-    def _int(v) -> int:
-        return int(v) if v.is_resolvable else UNKNOWN
-
     async def _watch(self, name, sig):
         while True:
             await sig.value_change
             await ReadOnly()
             if self.active:
-                self.changes[name].append((self._cycle(), self._int(sig.value)))
+                self.changes[name].append((self._cycle(), resolved(sig.value)))
 
     async def _run(self):
         while True:
@@ -449,9 +435,9 @@ class BeatMonitor:
                 continue
             if not int(v):
                 continue
-            beat = [self._cycle(), self._int(self.data.value), self._int(self.eol.value), self._int(self.eof.value),
-                    self._int(self.cam.value) if self.cam is not None else 0]
-            beat += [self._int(s.value) for s in self.extra.values()]
+            beat = [self._cycle(), resolved(self.data.value), resolved(self.eol.value), resolved(self.eof.value),
+                    resolved(self.cam.value) if self.cam is not None else 0]
+            beat += [resolved(s.value) for s in self.extra.values()]
             if UNKNOWN in beat[1:]:
                 self.undefined.append(f"cycle {beat[0]}: beat {beat[1:]} has undefined bits")
             self.beats.append(tuple(beat))

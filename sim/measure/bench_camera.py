@@ -25,6 +25,7 @@ import numpy as np
 from eyestereo.hdl.flow import synth
 from eyestereo.sim.lib.runner import BUILD, ROOT, run_bench
 from eyestereo.tools.camera import CameraTiming, cut, frame_schedule, yuv_frame
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 from eyestereo.tools.models.async_fifo import ClockSpec
 from eyestereo.tools.models.camera_interface import AmbiguousSchedule, camera_interface
 
@@ -46,7 +47,7 @@ def _kw():
 
 
 # --- depth: the longest stall absorbed ----------------------------------------------------------------
-DEPTH_TIMING = CameraTiming(width=352, height=16, h_blank=192, v_sync=1, v_back=1, v_front=1)
+DEPTH_TIMING = CameraTiming(width=FRAME_WIDTH, height=16, h_blank=192, v_sync=1, v_back=1, v_front=1)
 
 
 def _stall_start(t: CameraTiming) -> int:
@@ -139,7 +140,7 @@ FULL = [
 
 
 def full_case(name, block, cam_mhz, sys_mhz, frames) -> dict:
-    params = dict(width=352, height=288, order="YUYV", vsync_active=1, href_active=1, depth=1024)
+    params = dict(width=FRAME_WIDTH, height=FRAME_HEIGHT, order="YUYV", vsync_active=1, href_active=1, depth=1024)
     if block == "camera_pair":
         cams = [dict(prefix="cam_l", pclk=[ps(cam_mhz[0]), 30011], frames=frames),
                 dict(prefix="cam_r", pclk=[ps(cam_mhz[1]), 51234], frames=["file:chessboard_left01.jpg"])]
@@ -221,7 +222,8 @@ def report(depths, full, resources) -> str:
         "",
         "## Full frames at the thesis's clocks",
         "",
-        "352 x 288 frames of real colour images (Y from the grey image, U and V from the colour one), "
+        f"{FRAME_WIDTH} x {FRAME_HEIGHT} frames of real colour images (Y from the grey image, U and V from the "
+        "colour one), "
         "default OV6630 timing; every word taken compared with the model (words and read edge), every "
         "frame with the camera image.",
         "",

@@ -28,23 +28,25 @@ import cv2
 import numpy as np
 from myhdl import Signal, intbv
 
-from eyestereo.hdl.flow import catalog
-from eyestereo.hdl.flow.catalog import BENCH_TOPS, BlockSpec, _k_port, _thr_ports
-from eyestereo.hdl.harris.cornerness_stereo import cornerness_stereo
-from eyestereo.hdl.harris.harris_stereo import latency, multipliers
-from eyestereo.hdl.harris.harris_window_stereo import harris_window_stereo
-from eyestereo.hdl.harris.nms_stereo import nms_stereo
-from eyestereo.hdl.harris.prethreshold_stereo import prethreshold_stereo
-from eyestereo.hdl.harris.sobel_stereo import sobel_stereo
+from eyestereo.hdl.flow.catalog import BENCH_TOPS, BlockSpec, k_port as _k_port, thr_ports as _thr_ports
+from eyestereo.hdl.harris.cornerness import cornerness
+from eyestereo.hdl.harris.harris_stereo import multipliers
+from eyestereo.hdl.harris.harris_window import harris_window
+from eyestereo.hdl.harris.nms import nms
+from eyestereo.hdl.harris.prethreshold import prethreshold
+from eyestereo.hdl.harris.sobel import sobel
 from eyestereo.sim.lib.runner import ROOT, hdl_revision, revision_note, run_bench
 from eyestereo.tools.models import cornerness as corner_model
 from eyestereo.tools.models import harris_mono as hm
 from eyestereo.tools.models import harris_window as window_model
 from eyestereo.tools.models import sobel as sobel_model
+from eyestereo.tools.constants import (FRAME_HEIGHT, FRAME_WIDTH, K_CODE_DEFAULT, NMS_DEFAULT, SHARE_FACTORS,
+                                       THRESHOLD_BLOCKS)
+from eyestereo.tools.io import centre_crop
 
 BUILD = ROOT / "build" / "bench_harris_stereo"
-W, H = 352, 288
-K = [hm.k_code(0.04), hm.k_code(0.06)]
+W, H = FRAME_WIDTH, FRAME_HEIGHT
+K = [K_CODE_DEFAULT, hm.k_code(0.06)]
 THR = [[hm.threshold_code(c) for c in (2e8, 4e8, 1e8, 6e8, 3e8, 1e9, 5e7, 2e8, 8e8, 1e8, 3e8, 4e8, 6e8, 2e8, 1e8, 5e8)],
        [hm.threshold_code(c) for c in (3e8, 1e8, 2e8, 2e8, 5e8, 4e8, 1e8, 3e8, 2e8, 6e8, 1e8, 2e8, 3e8, 4e8, 2e8, 1e8)]]
 PAIRS = {"Tsukuba": ("middlebury/tsukuba/im3.png", "middlebury/tsukuba/im4.png"),
@@ -70,31 +72,29 @@ def _stereo_stage(name, func, sink, source, hw, control=(), **defaults):
 
 def register_stages() -> None:
     """The five stages as simulation/synthesis-only top levels (catalogue BENCH_TOPS), share 3, nms 3, 4x4."""
-    BENCH_TOPS["sobel_stereo"] = _stereo_stage("sobel_stereo", sobel_stereo, 8, sobel_model.WORD.width,
+    BENCH_TOPS["sobel_stereo"] = _stereo_stage("sobel_stereo", sobel, 8, sobel_model.WORD.width,
                                                ("width", "height", "share"), share=3)
-    BENCH_TOPS["harris_window_stereo"] = _stereo_stage("harris_window_stereo", harris_window_stereo,
+    BENCH_TOPS["harris_window_stereo"] = _stereo_stage("harris_window_stereo", harris_window,
                                                        sobel_model.WORD.width, window_model.WORD.width,
                                                        ("width", "height", "share"), share=3)
-    BENCH_TOPS["cornerness_stereo"] = _stereo_stage("cornerness_stereo", cornerness_stereo, window_model.WORD.width,
+    BENCH_TOPS["cornerness_stereo"] = _stereo_stage("cornerness_stereo", cornerness, window_model.WORD.width,
                                                     corner_model.WORD.width, ("share",),
                                                     control=(("k_left", _k_port), ("k_right", _k_port)), share=3)
     thr = _thr_ports()
+    # The stereo prethreshold's address is 2 * block + cam: one bit more than the mono one.
+    stereo_addr = ("thr_addr", lambda p: Signal(intbv(0)[len(thr[1][1](p)) + 1:]))
     BENCH_TOPS["prethreshold_stereo"] = _stereo_stage(
-        "prethreshold_stereo", prethreshold_stereo, corner_model.WORD.width, corner_model.WORD.width,
-        ("width", "height", "blocks"), control=(thr[0], ("thr_cam", lambda p: Signal(bool(0))), *thr[1:]),
-        blocks=(4, 4))
-    BENCH_TOPS["nms_stereo"] = _stereo_stage("nms_stereo", nms_stereo, corner_model.WORD.width, 1,
-                                             ("width", "height", "size", "share"), size=3, share=3)
+        "prethreshold_stereo", prethreshold, corner_model.WORD.width, corner_model.WORD.width,
+        ("width", "height", "blocks"), control=(thr[0], stereo_addr, thr[2]), blocks=THRESHOLD_BLOCKS)
+    BENCH_TOPS["nms_stereo"] = _stereo_stage("nms_stereo", nms, corner_model.WORD.width, 1,
+                                             ("width", "height", "size", "share"), size=NMS_DEFAULT, share=3)
 
 
 def crop(path: Path) -> np.ndarray:
     img = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
     if img is None:
         raise FileNotFoundError(f"cannot read {path}")
-    if img.shape[0] < H or img.shape[1] < W:
-        raise ValueError(f"{path} is {img.shape[1]}x{img.shape[0]}, smaller than {W}x{H}")
-    y0, x0 = (img.shape[0] - H) // 2, (img.shape[1] - W) // 2
-    return img[y0:y0 + H, x0:x0 + W]
+    return centre_crop(img, W, H, str(path))
 
 
 def sim_entry(share: int, rep: dict, names, duty, wall: float) -> dict:
@@ -125,7 +125,7 @@ def model_corners(names, shared: Path) -> list[list[int]]:
     out = []
     for n in names:
         left, right = pair_images(n, shared)
-        fl, fr, mask = model.harris_stereo(left, right, K, THR, blocks=(4, 4), nms=3)
+        fl, fr, mask = model.harris_stereo(left, right, K, THR, blocks=THRESHOLD_BLOCKS, nms=NMS_DEFAULT)
         out.append([int((fl.astype(bool) & mask).sum()), int((fr.astype(bool) & mask).sum())])
     return out
 
@@ -150,7 +150,7 @@ def run_sim(shared: Path, shares, stress: bool = False) -> dict:
         key = f"stress {share}" if stress else share
         t0 = time.perf_counter()
         rep = run_bench("harris_stereo", "tb_harris_stereo", cfg, name=f"bench_{'stress' if stress else 'share'}{share}",
-                        params=dict(width=W, height=H, blocks=(4, 4), nms=3, share=share),
+                        params=dict(width=W, height=H, blocks=THRESHOLD_BLOCKS, nms=NMS_DEFAULT, share=share),
                         build_root=ROOT / "build" / "sim")
         wall = time.perf_counter() - t0
         out[key] = sim_entry(share, rep, [_label(n) for n in names], duty, wall)
@@ -258,7 +258,7 @@ def render(sim: dict | None, synth: dict | None) -> str:
                       "| share | token after beat | then pairs, back to back | duty | flags compared | corners left / right | "
                       "clocks | GHDL back end, numeric_std | wall time (1-min load at the end) | date | HDL revision |",
                       "|---:|---:|---|---:|---:|---|---:|---|---:|---|---|"]
-            for k, r in sorted(stress.items()):
+            for _share, r in sorted(stress.items()):
                 fl = ", ".join(f"{a} / {b}" for a, b in r.get("corners", []))
                 lines.append(f"| {r['share']} | {r['token_after']:,} | {' + '.join(r['pairs'])} | {r['duty']} | "
                              f"{r['pixels_compared']} | {fl} | {r['clocks']:,} | {r.get('backend', 'mcode')}, "
@@ -338,7 +338,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m eyestereo.sim.measure.bench_harris_stereo", description=__doc__.split("\n")[0])
     ap.add_argument("--out", type=Path, required=True)
     ap.add_argument("--shared", type=Path, default=ROOT.parent / "shared" / "data")
-    ap.add_argument("--shares", type=int, nargs="*", default=[1, 2, 3])
+    ap.add_argument("--shares", type=int, nargs="*", default=list(SHARE_FACTORS))
     ap.add_argument("--no-sim", action="store_true")
     ap.add_argument("--no-stress", action="store_true", help="only the rate runs (one real pair per share at full rate)")
     ap.add_argument("--no-rate", action="store_true", help="only the stress runs")

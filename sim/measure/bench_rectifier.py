@@ -36,7 +36,8 @@ import cv2
 import numpy as np
 
 from eyestereo.sim.lib.runner import BUILD, ROOT, hdl_revision, revision_note, run_bench, slug
-from eyestereo.tools.io import atomic_write_text
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
+from eyestereo.tools.reports import publish
 
 OUT = ROOT / "build" / "bench_rectifier"
 DOC = ROOT / "docs" / "rectifier.md"
@@ -87,7 +88,7 @@ def _invert(mx: np.ndarray, my: np.ndarray, u: np.ndarray, v: np.ndarray, iterat
     return x, y
 
 
-def synthetic_pair(width: int = 352, height: int = 288, ss: int = 4) -> dict:
+def synthetic_pair(width: int = FRAME_WIDTH, height: int = FRAME_HEIGHT, ss: int = 4) -> dict:
     """Camera images of the board scene seen through the synthetic rig (exact maps), anti-aliased."""
     from eyestereo.tools.rectify.synthetic_rig import rig_maps
 
@@ -155,18 +156,20 @@ def run_frame(label: str, spec: str, left: np.ndarray, right: np.ndarray, mem: d
     return rep
 
 
-#: Seeds of the further full 352x288 frames with the random-delay memory.
+#: Seeds of the further full camera frames with the random-delay memory.
 EXTRA_SEEDS = (5, 6, 7, 8)
+#: The synthetic rig's runs are labelled (and their folders and figure found) by this.
+RIG = f"synthetic rig {FRAME_WIDTH}x{FRAME_HEIGHT}"
 
 
 def frames_to_run(quick: bool) -> list[tuple[str, str, str, dict, int]]:
-    runs = [("synthetic rig 352x288, memory at once", "rig", "synthetic", MEMORIES["at once"], 1),
-            ("synthetic rig 352x288, random delays", "rig", "synthetic", MEMORIES["random delays"], 2)]
+    runs = [(f"{RIG}, memory at once", "rig", "synthetic", MEMORIES["at once"], 1),
+            (f"{RIG}, random delays", "rig", "synthetic", MEMORIES["random delays"], 2)]
     if not quick:
         runs += [("OpenCV chessboard 640x480, memory at once", "opencv", "opencv", MEMORIES["at once"], 3),
                  ("OpenCV chessboard 640x480, random delays", "opencv", "opencv", MEMORIES["random delays"], 4)]
         # more seeds of the random memory on full frames (the small-frame regressions run many more)
-        runs += [(f"synthetic rig 352x288, random delays, seed {s}", "rig", "synthetic", MEMORIES["random delays"], s)
+        runs += [(f"{RIG}, random delays, seed {s}", "rig", "synthetic", MEMORIES["random delays"], s)
                  for s in EXTRA_SEEDS]
     return runs
 
@@ -199,17 +202,17 @@ def corners(img: np.ndarray):
 
 
 def analyse() -> dict:
+    from eyestereo.hdl.rectify.calibration import calibration_param
     from eyestereo.tools.models.coordinate_warper import coordinate_warper
-    from eyestereo.tools.models.poly_unit import Calibration, resolve_frac
+    from eyestereo.tools.models.poly_unit import resolve_frac
     from eyestereo.tools.models import rectifier as rect_model
 
     res = {"frames": [], "remap": [], "rows": None}
     scene = None
-    for label, spec, kind, mem, seed in frames_to_run(False):
+    for label, *_ in frames_to_run(False):
         f = OUT / slug(label) / "report.json"
         if f.exists():
             res["frames"].append(json.loads(f.read_text()))
-    done = {r["spec"] for r in res["frames"]}
     for spec, kind in (("rig", "synthetic"), ("opencv", "opencv")):
         runs = [r for r in res["frames"] if r["spec"] == spec]
         if not runs:
@@ -217,7 +220,7 @@ def analyse() -> dict:
         folder = OUT / slug(runs[0]["label"])
         hw = np.load(folder / "out.npz")
         cams = {s: np.load(folder / f"{s}_in.npy") for s in ("left", "right")}
-        cal = Calibration.load(spec)
+        cal = calibration_param(spec)  # what the bench's rectifier (quantizers=spec) was built from
         frac = resolve_frac(cal, None)
         pr = coordinate_warper(cal, frac)
         model_l, model_r = rect_model.rectifier(cal, cams["left"], cams["right"], frac)
@@ -405,19 +408,9 @@ def report_text(res: dict, rs: list[dict]) -> str:
               "(the rectifier's VHDL, memory model at once), lines every 32 rows.", ""]
     if FIG_RIG.exists():
         L += ["![synthetic rig](img/rectifier_rig.png)", "",
-              "The synthetic-rig scene (352x288) before and after the rectification in GHDL, lines every 32 rows.", ""]
+              f"The synthetic-rig scene ({FRAME_WIDTH}x{FRAME_HEIGHT}) before and after the rectification in GHDL, "
+              "lines every 32 rows.", ""]
     return "\n".join(L)
-
-
-def write_doc(text: str) -> None:
-    doc = DOC.read_text()
-    block = f"{BEGIN}\n{text}\n{END}"
-    if BEGIN in doc:
-        a, b = doc.index(BEGIN), doc.index(END) + len(END)
-        doc = doc[:a] + block + doc[b:]
-    else:
-        doc = doc.rstrip() + "\n\n## Measured: the rectification unit (fetch, interpolation, full frames)\n\n" + block + "\n"
-    atomic_write_text(DOC, doc)
 
 
 def main(argv=None) -> int:
@@ -439,11 +432,9 @@ def main(argv=None) -> int:
         if not rs and (OUT / "resources.json").exists():
             rs = json.loads((OUT / "resources.json").read_text())
         figure()
-        figure(FIG_RIG, "*352x288*at_once*")
-        text = report_text(res, rs)
-        print(text)
-        if not a.no_write:
-            write_doc(text)
+        figure(FIG_RIG, f"{slug(RIG)}*at_once*")
+        # the section keeps a blank line before its end marker
+        publish(report_text(res, rs) + "\n", None if a.no_write else DOC, BEGIN, END)
     return 0
 
 

@@ -28,6 +28,7 @@ from pathlib import Path
 
 from eyestereo.sim.lib.sram_runner import run_sram_bench
 from eyestereo.tools.models.sram_arbiter import MASTERS, AddressMap
+from eyestereo.tools.reports import markdown_table
 
 W, H = 32, 16
 PARAMS = dict(read_latency=2, width=W, height=H, feature_words=64)
@@ -211,136 +212,138 @@ def report(res: dict) -> str:
           f"Camera and rectified double buffers take {6 * amap.frame:,} words, the feature lists "
           f"{2 * amap.feature_words:,}; {amap.words - amap.host_base:,} words "
           f"({100 * (amap.words - amap.host_base) / amap.words:.0f} %) are left for the host.", ""]
-    rt = res.get("random", [])
-    if rt:
-        L += ["## Random traffic against the SRAM model", "",
-              "All six masters at once (cameras at 9 M words/s, the rectified stream with a reset token in some "
-              "runs, feature lists up to 80 words into 64-word buffers, fetch passes, the host's random reads and "
-              "writes and its buffer reads), overlapped and sequential mode. Every read is checked against the "
-              "last word written (fetch and host buffer reads against the frames the writers were given, "
-              "rebuilt from the SRAM's write log: a read of a half-written frame fails), every write lands "
-              "where its frame says, the part's rules hold on every edge, the counters match.", "",
-              "| part | runs | seeds | clocks | reads checked | writes checked | frames | result |",
-              "|---|---:|---|---:|---:|---:|---:|---|"]
-        for kind in KINDS:
-            rs = [r for r in rt if r["kind"] == kind]
-            if rs:
-                L.append(f"| {kind} | {len(rs)} | {min(r['seed'] for r in rs)}..{max(r['seed'] for r in rs)} | "
-                         f"{sum(r['clocks'] for r in rs):,} | {sum(r['fetch_reads'] + r['host_reads'] for r in rs):,} | "
-                         f"{sum(r['writes'] for r in rs):,} | {sum(r['frames'] for r in rs)} | all passed |")
-        L.append("")
-    bw = res.get("bandwidth", [])
-    if bw:
-        L += ["## Bandwidth (words per clock, 1.0 = 100 M words/s)", "",
-              "Measured at the SRAM's pins over the second half of each run, read latency 2.", "",
-              "| load | part | words/clock | reads | writes | idle bus cycles | cameras | fetch | rectified | host |",
-              "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
-        for b in bw:
-            p = b["per"]
-            L.append(f"| {b['load']} | {b['kind']} | {b['total']:.3f} | {b['reads']:.3f} | {b['writes']:.3f} | "
-                     f"{b['idle']:.3f} | {p['cam0'] + p['cam1']:.3f} | {p['fetch']:.3f} | {p['rect']:.3f} | "
-                     f"{p['host']:.3f} |")
-        L += ["", "A NoBL part turns the bus round for free; a pipelined SyncBurst part loses three clocks each "
-              "time writes follow reads (one idle bus cycle for tCHZ, and a write's data goes with its "
-              "address), which is why writers collect bursts of 8 words.", ""]
-    mg = res.get("margin", [])
-    if mg:
-        L += ["## Camera margin", "",
-              "Both cameras at the same word rate while the rectifier fetches without pause, the rectified "
-              "writer runs and the host reads the rectified images at 12.5 M words/s; camera FIFO (the async "
-              "FIFO's read side) 1024 words. Camera writers are urgent, so their rate takes bandwidth from the "
-              "rectifier and the host, not the other way round. A rate is *sustained* when the cameras' words are written as fast as they come "
-              "and the FIFO stays nearly empty (at most 64 words): a FIFO that keeps filling overflows in a "
-              "longer run.", "",
-              "| part | camera rate (M words/s each) | x 9 M | max FIFO fill | sustained | cameras (words/clock) | "
-              "fetch (words/clock) | camera wait per word (clocks) |", "|---|---:|---:|---:|---|---:|---:|---:|"]
-
-        def sustained(m):
-            return "failed" not in m and not m["overflow"] and m["fill"] <= 64 and m["cams"] >= 0.98 * 2 * m["rate"]
-
-        for m in mg:
-            if "failed" in m:
-                L.append(f"| {m['kind']} | {m['rate'] * CLOCK_MHZ:.0f} | {m['rate'] / CAM_RATE:.1f} | - | no (bench "
-                         f"failed: {m['failed'][:60]}) | | | |")
-                continue
-            L.append(f"| {m['kind']} | {m['rate'] * CLOCK_MHZ:.0f} | {m['rate'] / CAM_RATE:.1f} | {m['fill']} | "
-                     f"{'yes' if sustained(m) else 'no'} | {m['cams']:.3f} | {m['fetch']:.3f} | "
-                     f"{m['wait_per_word']:.2f} |")
-        L.append("")
-        for kind in KINDS:
-            ok = [m["rate"] for m in mg if m["kind"] == kind and sustained(m)]
-            bad = [m["rate"] for m in mg if m["kind"] == kind and not sustained(m)]
-            if ok:
-                L.append(f"- {kind}: sustained up to {max(ok) * CLOCK_MHZ:.0f} M words/s per camera, "
-                         f"{max(ok) / CAM_RATE:.1f} times the cameras' 9 M words/s" +
-                         (f"; not at {min(bad) * CLOCK_MHZ:.0f} M words/s." if bad else " (the highest rate tried)."))
-        L.append("")
-    sh = res.get("shares", [])
-    if sh:
-        L += ["## Share of the SRAM's clocks under the system's load", "",
-              "Cameras at 9 M words/s each, the rectifier fetching without pause (4 pixels per request), the "
-              "rectified writer at about an eighth of the fetch rate (one packed word per 8 reads: 4 pixels "
-              "per camera), feature lists, the host reading the rectified images at 12.5 M words/s. Inputs of "
-              "the complete system's frame-rate measurement.", "",
-              "| part | " + " | ".join(MASTERS) + " | idle / turnaround | total words/clock |",
-              "|---|" + "---:|" * (len(MASTERS) + 2)]
-        for s in sh:
-            p = s["per"]
-            L.append(f"| {s['kind']} | " + " | ".join(f"{100 * p[m]:.1f} %" for m in MASTERS) +
-                     f" | {100 * (1 - s['total']):.1f} % | {s['total']:.3f} |")
-        L += ["", "| part | clocks waited per word: " + " | ".join(MASTERS) + " | fetch latency min / median / max |",
-              "|---|" + "---:|" * (len(MASTERS) + 1)]
-        for s in sh:
-            lat = s["fetch_latency"]
-            L.append(f"| {s['kind']} | " + " | ".join(
-                f"{s['waited'][m] / max(1, s['moved'][m]):.2f}" for m in MASTERS) +
-                (f" | {lat[0]} / {lat[1]:.0f} / {lat[2]} |" if lat else " | - |"))
-        for s in sh:
-            f = s["per"]["fetch"]
-            if f > 0:
-                frame = AddressMap().frame
-                ms = 8 * frame / (f * CLOCK_MHZ * 1e3)
-                L.append("")
-                L.append(f"- {s['kind']}: at {f:.3f} fetch words per clock one stereo frame's 8 x 101,376 reads "
-                         f"take {ms:.1f} ms ({1000 / ms:.0f} frames/s for the rectifier alone; derived, not "
-                         f"simulated at 352x288).")
-        L.append("")
-    li = res.get("latency", [])
-    if li:
-        L += ["Latency on a quiet bus, from the clock a request is taken to the clock its data comes back: fetch "
-              "(first pixel) " + ", ".join(f"{x['kind']} {x['min']} (median {x['median']:.0f})" for x in li) +
-              "; host read " + ", ".join(f"{x['kind']} {x['host_min']} (median {x['host_median']:.0f})" for x in li) +
-              " clocks.", ""]
-    rs = res.get("resources", [])
-    if rs:
-        L += ["## Resources and clock", "",
-              "`make synth`'s flow: the VHDL synthesized by GHDL, then Yosys `synth_xilinx -family xc3se` (the "
-              "thesis's Spartan-3E); default parameters (352x288, 32-bit counters, NoBL) unless the row says "
-              "otherwise. *Est. period*: the longest register-to-register path of that Spartan-3E netlist with "
-              "the XC3S500E -4 data-sheet cell delays and 0.7 ns per net (`hdl/flow/sta.py`; no place and route "
-              "exists for the Spartan-3E here, so this is an estimate). *ECP5*: nextpnr-ecp5 place and route of "
-              "the same GHDL netlist, speed grade 6, the clock constrained at 100 MHz (the SRAM's), on the "
-              "device named (blocks with more port bits than the LFE5U-25F's package has pins go on the 85k "
-              "part): a real timing figure, of another family.", "",
-              "| block | LUT | LUT-RAM | FF | RAMB16 | MULT18X18 | carry cells | LUT levels | est. period (S3E-4) | "
-              "ECP5 fmax | ECP5 device |", "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
-        for r in rs:
-            s_ = r["summary"]
-            fm = f"{r['ecp5_fmax']:.1f} MHz" if r.get("ecp5_fmax") else "-"
-            dev = r.get("ecp5_device", "")
-            dev = "LFE5U-85F CABGA756" if "85k" in dev else ("LFE5U-25F CABGA381" if dev else "")
-            L.append(f"| {r['block']} | {s_['LUT']} | {s_['LUTRAM']} | {s_['FF']} | {s_['RAMB16']} | "
-                     f"{s_['MULT18X18']} | {s_['carry']} | {r['levels']} | {r['period']} ns ({r['fmax']} MHz) | "
-                     f"{fm} | {dev} |")
-        L += ["", "The arbiter alone has its word port on pins as well (far-apart I/O on the 85k device), which "
-              "costs it in the place and route; inside the subsystem that port is internal. The 32-bit counters "
-              "(12 counters of words moved and clocks waited, and the clock counter) are about 230 of the "
-              "arbiter's LUTs (`counter_bits=16`: the row above).", ""]
-    sp = res.get("speed")
-    if sp:
-        L += [f"Simulation speed (GHDL mcode, cocotb, the SRAM model and six agents in Python): about "
-              f"{sp:,.0f} clocks per second.", ""]
+    for key, section in (("random", _random_section), ("bandwidth", _bandwidth_section),
+                         ("margin", _margin_section), ("shares", _shares_section), ("latency", _latency_section),
+                         ("resources", _resources_section), ("speed", _speed_section)):
+        if res.get(key):
+            L += section(res[key])
     return "\n".join(L) + "\n"
+
+
+# The page's measured sections: each renders its entry of the results (skipped when missing or empty).
+def _random_section(rt: list[dict]) -> list[str]:
+    rows = []
+    for kind in KINDS:
+        rs = [r for r in rt if r["kind"] == kind]
+        if rs:
+            rows.append([kind, len(rs), f"{min(r['seed'] for r in rs)}..{max(r['seed'] for r in rs)}",
+                         f"{sum(r['clocks'] for r in rs):,}", f"{sum(r['fetch_reads'] + r['host_reads'] for r in rs):,}",
+                         f"{sum(r['writes'] for r in rs):,}", sum(r["frames"] for r in rs), "all passed"])
+    return ["## Random traffic against the SRAM model", "",
+            "All six masters at once (cameras at 9 M words/s, the rectified stream with a reset token in some "
+            "runs, feature lists up to 80 words into 64-word buffers, fetch passes, the host's random reads and "
+            "writes and its buffer reads), overlapped and sequential mode. Every read is checked against the "
+            "last word written (fetch and host buffer reads against the frames the writers were given, "
+            "rebuilt from the SRAM's write log: a read of a half-written frame fails), every write lands "
+            "where its frame says, the part's rules hold on every edge, the counters match.", ""] + markdown_table(
+        ["part", "runs", "seeds", "clocks", "reads checked", "writes checked", "frames", "result"], rows,
+        "lrlrrrrl") + [""]
+
+
+def _bandwidth_section(bw: list[dict]) -> list[str]:
+    rows = [[b["load"], b["kind"]] + [f"{v:.3f}" for v in (
+        b["total"], b["reads"], b["writes"], b["idle"], b["per"]["cam0"] + b["per"]["cam1"], b["per"]["fetch"],
+        b["per"]["rect"], b["per"]["host"])] for b in bw]
+    return ["## Bandwidth (words per clock, 1.0 = 100 M words/s)", "",
+            "Measured at the SRAM's pins over the second half of each run, read latency 2.", ""] + markdown_table(
+        ["load", "part", "words/clock", "reads", "writes", "idle bus cycles", "cameras", "fetch", "rectified", "host"],
+        rows, "ll" + "r" * 8) + [
+        "", "A NoBL part turns the bus round for free; a pipelined SyncBurst part loses three clocks each "
+        "time writes follow reads (one idle bus cycle for tCHZ, and a write's data goes with its "
+        "address), which is why writers collect bursts of 8 words.", ""]
+
+
+def _sustained(m: dict) -> bool:
+    """A camera rate the SRAM keeps up with: no overflow, the FIFO nearly empty, every word written."""
+    return "failed" not in m and not m["overflow"] and m["fill"] <= 64 and m["cams"] >= 0.98 * 2 * m["rate"]
+
+
+def _margin_section(mg: list[dict]) -> list[str]:
+    rows = []
+    for m in mg:
+        rate = [m["kind"], f"{m['rate'] * CLOCK_MHZ:.0f}", f"{m['rate'] / CAM_RATE:.1f}"]
+        if "failed" in m:
+            rows.append(rate + ["-", f"no (bench failed: {m['failed'][:60]})", "", "", ""])
+        else:
+            rows.append(rate + [m["fill"], "yes" if _sustained(m) else "no", f"{m['cams']:.3f}", f"{m['fetch']:.3f}",
+                                f"{m['wait_per_word']:.2f}"])
+    L = ["## Camera margin", "",
+         "Both cameras at the same word rate while the rectifier fetches without pause, the rectified "
+         "writer runs and the host reads the rectified images at 12.5 M words/s; camera FIFO (the async "
+         "FIFO's read side) 1024 words. Camera writers are urgent, so their rate takes bandwidth from the "
+         "rectifier and the host, not the other way round. A rate is *sustained* when the cameras' words are written as fast as they come "
+         "and the FIFO stays nearly empty (at most 64 words): a FIFO that keeps filling overflows in a "
+         "longer run.", ""] + markdown_table(
+        ["part", "camera rate (M words/s each)", "x 9 M", "max FIFO fill", "sustained", "cameras (words/clock)",
+         "fetch (words/clock)", "camera wait per word (clocks)"], rows, "lrrrlrrr") + [""]
+    for kind in KINDS:
+        ok = [m["rate"] for m in mg if m["kind"] == kind and _sustained(m)]
+        bad = [m["rate"] for m in mg if m["kind"] == kind and not _sustained(m)]
+        if ok:
+            L.append(f"- {kind}: sustained up to {max(ok) * CLOCK_MHZ:.0f} M words/s per camera, "
+                     f"{max(ok) / CAM_RATE:.1f} times the cameras' 9 M words/s" +
+                     (f"; not at {min(bad) * CLOCK_MHZ:.0f} M words/s." if bad else " (the highest rate tried)."))
+    return L + [""]
+
+
+def _shares_section(sh: list[dict]) -> list[str]:
+    L = ["## Share of the SRAM's clocks under the system's load", "",
+         "Cameras at 9 M words/s each, the rectifier fetching without pause (4 pixels per request), the "
+         "rectified writer at about an eighth of the fetch rate (one packed word per 8 reads: 4 pixels "
+         "per camera), feature lists, the host reading the rectified images at 12.5 M words/s. Inputs of "
+         "the complete system's frame-rate measurement.", ""]
+    L += markdown_table(["part", *MASTERS, "idle / turnaround", "total words/clock"], [
+        [s["kind"], *(f"{100 * s['per'][m]:.1f} %" for m in MASTERS), f"{100 * (1 - s['total']):.1f} %",
+         f"{s['total']:.3f}"] for s in sh])
+    L += [""] + markdown_table(["part", *(f"clocks waited per word: {m}" if i == 0 else m for i, m in enumerate(MASTERS)),
+                                "fetch latency min / median / max"], [
+        [s["kind"], *(f"{s['waited'][m] / max(1, s['moved'][m]):.2f}" for m in MASTERS),
+         "{} / {:.0f} / {}".format(*s["fetch_latency"]) if s["fetch_latency"] else "-"] for s in sh])
+    for s in sh:
+        f = s["per"]["fetch"]
+        if f > 0:
+            ms = 8 * AddressMap().frame / (f * CLOCK_MHZ * 1e3)
+            L += ["", f"- {s['kind']}: at {f:.3f} fetch words per clock one stereo frame's 8 x 101,376 reads "
+                  f"take {ms:.1f} ms ({1000 / ms:.0f} frames/s for the rectifier alone; derived, not "
+                  f"simulated at 352x288)."]
+    return L + [""]
+
+
+def _latency_section(li: list[dict]) -> list[str]:
+    return ["Latency on a quiet bus, from the clock a request is taken to the clock its data comes back: fetch "
+            "(first pixel) " + ", ".join(f"{x['kind']} {x['min']} (median {x['median']:.0f})" for x in li) +
+            "; host read " + ", ".join(f"{x['kind']} {x['host_min']} (median {x['host_median']:.0f})" for x in li) +
+            " clocks.", ""]
+
+
+def _resources_section(rs: list[dict]) -> list[str]:
+    rows = []
+    for r in rs:
+        s = r["summary"]
+        dev = r.get("ecp5_device", "")
+        rows.append([r["block"], s["LUT"], s["LUTRAM"], s["FF"], s["RAMB16"], s["MULT18X18"], s["carry"], r["levels"],
+                     f"{r['period']} ns ({r['fmax']} MHz)", f"{r['ecp5_fmax']:.1f} MHz" if r.get("ecp5_fmax") else "-",
+                     "LFE5U-85F CABGA756" if "85k" in dev else ("LFE5U-25F CABGA381" if dev else "")])
+    return ["## Resources and clock", "",
+            "`make synth`'s flow: the VHDL synthesized by GHDL, then Yosys `synth_xilinx -family xc3se` (the "
+            "thesis's Spartan-3E); default parameters (352x288, 32-bit counters, NoBL) unless the row says "
+            "otherwise. *Est. period*: the longest register-to-register path of that Spartan-3E netlist with "
+            "the XC3S500E -4 data-sheet cell delays and 0.7 ns per net (`hdl/flow/sta.py`; no place and route "
+            "exists for the Spartan-3E here, so this is an estimate). *ECP5*: nextpnr-ecp5 place and route of "
+            "the same GHDL netlist, speed grade 6, the clock constrained at 100 MHz (the SRAM's), on the "
+            "device named (blocks with more port bits than the LFE5U-25F's package has pins go on the 85k "
+            "part): a real timing figure, of another family.", ""] + markdown_table(
+        ["block", "LUT", "LUT-RAM", "FF", "RAMB16", "MULT18X18", "carry cells", "LUT levels", "est. period (S3E-4)",
+         "ECP5 fmax", "ECP5 device"], rows, "l" + "r" * 9 + "l") + [
+        "", "The arbiter alone has its word port on pins as well (far-apart I/O on the 85k device), which "
+        "costs it in the place and route; inside the subsystem that port is internal. The 32-bit counters "
+        "(12 counters of words moved and clocks waited, and the clock counter) are about 230 of the "
+        "arbiter's LUTs (`counter_bits=16`: the row above).", ""]
+
+
+def _speed_section(sp: float) -> list[str]:
+    return [f"Simulation speed (GHDL mcode, cocotb, the SRAM model and six agents in Python): about "
+            f"{sp:,.0f} clocks per second.", ""]
 
 
 def main(argv=None) -> int:

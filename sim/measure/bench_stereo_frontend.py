@@ -44,22 +44,17 @@ import time
 from pathlib import Path
 
 from eyestereo.sim.apps.cli_system import frame_size
+from eyestereo.sim.lib.frontend_runs import CLOCKS, PUBLIC, SHORT_BLANKING, figures
 from eyestereo.sim.lib.runner import ROOT, fastest_simulator, hdl_revision, revision_note, run_bench
 from eyestereo.tools.camera import CameraTiming
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 from eyestereo.tools.models.sram_arbiter import MASTERS
 
 THESIS_FPS = 20.01
-FULL = (352, 288)
-CLOCKS = {"memory": 100.0, "harris": 50.0, "camera_l": 18.0, "camera_r": 17.9}
-#: The blanking of the small frames (the camera model's rules: HREF inactive >= 1 PCLK between lines, a
-#: VSYNC of >= 1 line): real blanking would make a 48x32 frame mostly blanking.
-SHORT = dict(h_blank=64, v_sync=1, v_back=1, v_front=1)
+FULL = (FRAME_WIDTH, FRAME_HEIGHT)
+SHORT = SHORT_BLANKING
 RUNS = ROOT / "build" / "system" / "runs"
 SPEED_SKIP_US = 1200  # the speed probe's window starts here: the cameras' active lines
-#: What the bench touches in the top (ports and the stage probes): on Verilator only these are public
-#: (run_bench's ``public``), the rest is left to Verilator's optimiser (1.3x at 64x48 here).
-PUBLIC = ["clk", "rst", "hclk", "hrst", "wrst_*", "cam_*", "bus_*", "sram_*", "rectifier*_busy",
-          "frontend_sequencer*_list_done", "sram_subsystem*_cam_held"]
 SIM_NAMES = {"verilator": "Verilator (MyHDL's Verilog of the top)", "icarus": "Icarus Verilog",
              "ghdl": "GHDL (mcode)", "ghdl-llvm": "GHDL (LLVM back end, -O2)"}
 
@@ -105,49 +100,6 @@ def run_mode(mode: str, size: str, frames: int, timing: dict, sim: str, reuse: b
     kept.write_text(json.dumps(rep) + "\n")
     print(f"[bench] {tag}: done in {rep['wall_s']} s", flush=True)
     return rep
-
-
-def figures(rep: dict, timing: CameraTiming) -> dict:
-    """The figures of one run: period, fps, read-out, stage times, SRAM shares, speed."""
-    w, h = rep["width"], rep["height"]
-    fr = rep["frames"]
-    read = [f["read_ns"] - f["frame_ns"] for f in fr]
-    out = dict(pixels=w * h, read_out_us=round(sum(read) / len(read) / 1e3, 2),
-               frame_clocks=rep["frame_clocks"], camera_frame_us=round(timing.frame_pclk / 18.0, 2))
-    stages = rep.get("stages", {})
-    done = stages.get("list_done_ns") or []
-    if rep["mode"] == "sequential":
-        # every frame's period: start to the next start; the last frame's, start to its read-out done (the
-        # next start would follow at once: a release pulse and a start over the bus)
-        periods = [b["start_ns"] - a["start_ns"] for a, b in zip(fr, fr[1:])] + [fr[-1]["read_ns"] - fr[-1]["start_ns"]]
-        out["period_from"] = (f"mean of {len(periods)} frames, start to start" if len(periods) > 1 else
-                              "start to read-out done")
-        out["period_us"] = round(sum(periods) / len(periods) / 1e3, 2)
-        out["periods_us"] = [round(p / 1e3, 2) for p in periods]
-    elif len(done) > 1:  # the steady state: completed frame to completed frame
-        out["period_us"] = round((done[-1] - done[0]) / (len(done) - 1) / 1e3, 2)
-        out["period_from"] = f"frame_done to frame_done, {len(done) - 1} intervals"
-    else:
-        out["period_us"] = round(rep["total_ns"] / rep["frames_done"] / 1e3, 2)
-        out["period_from"] = "run time / frames done"
-    out["fps"] = round(1e6 / out["period_us"], 2)
-    moved = {m: rep["arb"][f"moved_{m}"] for m in MASTERS}
-    clocks = rep["arb"]["clocks"]
-    out["sram_share"] = {m: round(v / clocks, 4) for m, v in moved.items()}
-    out["sram_busy"] = round(sum(moved.values()) / clocks, 4)
-    out["stages"] = {k: v for k, v in stages.items() if not k.endswith("_ns")}
-    out["frames_done"] = rep["frames_done"]
-    out["frames_read"] = len(fr)
-    out["bit_exact"] = rep["bit_exact"]
-    out["features"] = [f.get("totals") for f in fr]
-    if rep.get("wall_s"):
-        out["wall_s"] = rep["wall_s"]
-        out["sim_ms"] = round(rep["total_ns"] / 1e6, 2)
-    if rep.get("sim_seconds"):  # cocotb's time of the test (after the build): memory clocks per second
-        out["memory_clocks_per_s"] = round(rep["total_ns"] / 10 / rep["sim_seconds"])
-        out["test_s"] = round(rep["sim_seconds"], 1)
-    out["simulator"] = rep.get("simulator")
-    return out
 
 
 def full_frame(seq: dict, ovl: dict) -> dict:
@@ -277,7 +229,7 @@ def real_pair_arrays(files, size: str):
 
 def real_model(left, right, size: str, threshold: int, max_features: int) -> dict:
     """What the model finds in the pair (the bench's chain and parameters): per camera totals, listed, overflow."""
-    from eyestereo.hdl.rectify.poly_unit import calibration_param
+    from eyestereo.hdl.rectify.calibration import calibration_param
     from eyestereo.sim.benches.tb_stereo_frontend import model_params
     from eyestereo.tools.camera import yuv_frame
     from eyestereo.tools.models import stereo_frontend as model

@@ -35,7 +35,7 @@ import eyestereo.sim.harnesses.warper_harness  # noqa: F401  (registers the benc
 from eyestereo.hdl.flow import synth
 from eyestereo.sim.lib.runner import BUILD, ROOT, run_bench, slug
 from eyestereo.tools.rectify import calibrations
-from eyestereo.tools.io import atomic_write_text
+from eyestereo.tools.reports import markdown_table, publish
 
 TOP = "coordinate_warper_tb"
 BEGIN, END = "<!-- warper-bench:begin -->", "<!-- warper-bench:end -->"
@@ -105,16 +105,14 @@ def resources() -> list[dict]:
 def report(frames: list[dict], icarus: dict | None, res: list[dict], backend: str) -> str:
     lines = [f"Measured by `python -m eyestereo.sim.measure.bench_warper` on GHDL ({backend} back end); every pair of every "
              "frame compared with the bit-true model (all fields). Clocks per pair: between the first and the last "
-             "take of the frame; frame: clocks from `start` to `done`.", "",
-             "| frame | calibration | pairs compared | out of range L / R | clocks per pair | frame clocks "
-             "| sim speed (clk/s) |", "|---|---|---:|---:|---:|---:|---:|"]
-    for f in frames:
-        n = f["pairs"]
-        speed = f"{f['frame_clocks'][0] / f['sim']:.0f}" if f.get("sim") else "?"
-        lines.append(f"| {f['label']} | `{f['spec']}` {f['width']}x{f['height']} | {n:,} | "
-                     f"{100 * f['oor_l'] / n:.1f} % / {100 * f['oor_r'] / n:.1f} % | {f['clocks_per_pair']:.4f} | "
-                     f"{f['frame_clocks'][0]:,} | {speed} |")
-    lines.append("")
+             "take of the frame; frame: clocks from `start` to `done`.", ""]
+    lines += markdown_table(
+        ["frame", "calibration", "pairs compared", "out of range L / R", "clocks per pair", "frame clocks",
+         "sim speed (clk/s)"],
+        [[f["label"], f"`{f['spec']}` {f['width']}x{f['height']}", f"{f['pairs']:,}",
+          f"{100 * f['oor_l'] / f['pairs']:.1f} % / {100 * f['oor_r'] / f['pairs']:.1f} %", f"{f['clocks_per_pair']:.4f}",
+          f"{f['frame_clocks'][0]:,}", f"{f['frame_clocks'][0] / f['sim']:.0f}" if f.get("sim") else "?"]
+         for f in frames], "ll" + "r" * 5) + [""]
     at_once = [f for f in frames if f["consumer"].get("ack_p") == 256 and not f["consumer"].get("burst")]
     if at_once:
         cpp = sorted({round(f["clocks_per_pair"], 6) for f in at_once})
@@ -130,15 +128,14 @@ def report(frames: list[dict], icarus: dict | None, res: list[dict], backend: st
     lines += ["", "Resources of GHDL's netlist of the VHDL (`eyestereo.hdl.flow.synth`: `ghdl synth`, repaired, Yosys "
               "`synth_xilinx -family xc3se`; LUT = 4-input LUTs, carry cells not counted) and fmax of the same "
               "netlist placed and routed on an ECP5 (`nextpnr-ecp5`; the Spartan-3E has no open place and route: "
-              "the figure says how deep the logic is, the thesis's goal is 100 MHz):", "",
-              "| block | LUT | FF | LUT-RAM | MULT18X18 | fmax ECP5 (MHz) | thesis Table 4.4 (ISE, post-PAR): MULT / LUT |",
-              "|---|---:|---:|---:|---:|---:|---|"]
-    for r in res:
-        s = r["summary"]
-        th = {"poly_unit": "calculation unit: 9 / 262",
-              "coordinate_warper": "calculation unit + warper: 9 / 262 + 99 = 361"}.get(r["label"], "-")
-        fmax = ", ".join(f"{v['achieved']:.1f}" for v in (r.get("fmax") or {}).values()) or "-"
-        lines.append(f"| {r['label']} | {s['LUT']} | {s['FF']} | {s['LUTRAM']} | {s['MULT18X18']} | {fmax} | {th} |")
+              "the figure says how deep the logic is, the thesis's goal is 100 MHz):", ""]
+    thesis = {"poly_unit": "calculation unit: 9 / 262",
+              "coordinate_warper": "calculation unit + warper: 9 / 262 + 99 = 361"}
+    lines += markdown_table(
+        ["block", "LUT", "FF", "LUT-RAM", "MULT18X18", "fmax ECP5 (MHz)", "thesis Table 4.4 (ISE, post-PAR): MULT / LUT"],
+        [[r["label"], *(r["summary"][k] for k in ("LUT", "FF", "LUTRAM", "MULT18X18")),
+          ", ".join(f"{v['achieved']:.1f}" for v in (r.get("fmax") or {}).values()) or "-", thesis.get(r["label"], "-")]
+         for r in res], "l" + "r" * 5 + "l")
     by = {r["label"]: r["summary"] for r in res}
     if "poly_unit" in by and "coordinate_warper" in by:
         u, w = by["poly_unit"]["LUT"], by["coordinate_warper"]["LUT"]
@@ -160,14 +157,6 @@ def report(frames: list[dict], icarus: dict | None, res: list[dict], backend: st
     return "\n".join(lines) + "\n"
 
 
-def write_section(doc: Path, text: str) -> None:
-    old = doc.read_text(encoding="utf-8")
-    pattern = re.compile(re.escape(BEGIN) + r".*?" + re.escape(END), re.S)
-    if not pattern.search(old):
-        raise SystemExit(f"{doc}: no '{BEGIN}' ... '{END}' section to fill")
-    atomic_write_text(doc, pattern.sub(lambda _m: f"{BEGIN}\n{text}{END}", old))
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description="Full frames, throughput and resources of the coordinate warper.")
     ap.add_argument("--doc", type=Path, default=ROOT / "docs" / "rectifier.md")
@@ -184,11 +173,7 @@ def main(argv=None) -> int:
             print(f"skipped {label}: {exc}", file=sys.stderr)
     print("bench_warper: the netlist on Icarus ...", flush=True)
     icarus = None if args.quick else netlist_frame()
-    text = report(frames, icarus, resources(), backend)
-    sys.stdout.write(text)
-    if not args.no_write:
-        write_section(args.doc, text)
-        print(f"written to {args.doc}")
+    publish(report(frames, icarus, resources(), backend), None if args.no_write else args.doc, BEGIN, END)
     return 0
 
 

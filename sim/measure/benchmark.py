@@ -33,9 +33,10 @@ import numpy as np
 
 from eyestereo.hdl.flow import synth
 from eyestereo.sim.lib.runner import BUILD, ROOT, archived_tree, build_dir_of, run_bench, simulator_versions, slug
-from eyestereo.tools.io import atomic_write_text
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH, K_CODE_DEFAULT, NMS_DEFAULT, THRESHOLD_BLOCKS
+from eyestereo.tools.reports import publish
 
-W, H = 352, 288
+W, H = FRAME_WIDTH, FRAME_HEIGHT
 IMAGES = ["file:tsukuba_im3.png", "file:chessboard_left01.jpg"]
 THR16 = [40, 60, 25, 80, 40, 120, 15, 40, 90, 25, 40, 60, 80, 40, 25, 60]
 CASES = [
@@ -53,17 +54,18 @@ CASES = [
     ("harris_window", "harris_window", "tb_harris_window", dict(width=W, height=H), 2,
      ["sobel:" + i for i in IMAGES]),
     ("cornerness", "cornerness", "tb_cornerness", dict(width=W, height=H), 0,
-     ["window:" + i for i in IMAGES], dict(k=10)),
-    ("prethreshold 4x4", "prethreshold", "tb_prethreshold", dict(width=W, height=H, blocks=(4, 4)), 0,
-     ["corner:10:" + i for i in IMAGES], dict(thresholds=dict(enumerate(THR16)))),
+     ["window:" + i for i in IMAGES], dict(k=K_CODE_DEFAULT)),
+    ("prethreshold 4x4", "prethreshold", "tb_prethreshold", dict(width=W, height=H, blocks=THRESHOLD_BLOCKS), 0,
+     [f"corner:{K_CODE_DEFAULT}:" + i for i in IMAGES], dict(thresholds=dict(enumerate(THR16)))),
     ("nms 3x3", "nms", "tb_nms", dict(width=W, height=H, size=3), 1,
      ["rcorner:1:-50:50", "rcorner:2:-50:50"]),
     ("nms 5x5", "nms", "tb_nms", dict(width=W, height=H, size=5), 2,
      ["rcorner:1:-50:50", "rcorner:2:-50:50"]),
-    ("harris_mono (4x4, nms 3x3)", "harris_mono", "tb_harris_mono", dict(width=W, height=H, blocks=(4, 4), nms=3),
-     4, IMAGES, dict(k=10, thresholds=THR16)),
+    ("harris_mono (4x4, nms 3x3)", "harris_mono", "tb_harris_mono",
+     dict(width=W, height=H, blocks=THRESHOLD_BLOCKS, nms=NMS_DEFAULT), 4, IMAGES,
+     dict(k=K_CODE_DEFAULT, thresholds=THR16)),
     ("harris_mono (1x1, nms 5x5)", "harris_mono", "tb_harris_mono", dict(width=W, height=H, blocks=(1, 1), nms=5),
-     5, IMAGES, dict(k=10, thresholds=[40])),
+     5, IMAGES, dict(k=K_CODE_DEFAULT, thresholds=[40])),
 ]
 
 
@@ -145,7 +147,8 @@ def _available(sims: list[str]) -> list[str]:
     ok = []
     for name in sims:
         sim, backend = SIMULATORS[name]
-        if sim == "ghdl" and shutil.which(f"ghdl-{backend}") is None and not (backend == "mcode" and shutil.which("ghdl")):
+        if sim == "ghdl" and (shutil.which(f"ghdl-{backend}") is None
+                              and not (backend == "mcode" and shutil.which("ghdl"))):
             print(f"benchmark: {name} is not installed, left out (Debian: apt-get install ghdl-{backend})")
         elif sim == "icarus" and shutil.which("iverilog") is None:
             print("benchmark: icarus is not installed, left out (Debian: apt-get install iverilog)")
@@ -242,7 +245,8 @@ def run_before_commit(case, rev: str = BEFORE_COMMIT) -> dict:
         root = archived_tree(rev, BUILD.parent / "before" / rev)
     except ValueError as e:
         raise RuntimeError(str(e)) from None
-    spec = dict(block=block, bench=bench, params={k: (list(v) if isinstance(v, tuple) else v) for k, v in params.items()},
+    spec = dict(block=block, bench=bench,
+                params={k: (list(v) if isinstance(v, tuple) else v) for k, v in params.items()},
                 config=dict(extra, frames=frames, duty=1.0))
     env = dict(os.environ, PYTHONPATH=str(root / "pkg"), GHDL_BACKEND="mcode")
     r = subprocess.run([sys.executable, "-c", _BEFORE_SCRIPT, json.dumps(spec), str(root / "build" / "sim")],
@@ -289,7 +293,7 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
            f"Measured by `make bench` ({Path(__file__).name}) on {datetime.date.today()}: {cpu}, "
            f"{platform.python_implementation()} {platform.python_version()}, cocotb {cocotb.__version__}, "
            f"MyHDL {myhdl.__version__}; {tools}.", "", _load_note(results), "",
-           "## Throughput, latency (352x288, two frames back to back, 100 % input duty, GHDL on the VHDL)", "",
+           f"## Throughput, latency ({W}x{H}, two frames back to back, 100 % input duty, GHDL on the VHDL)", "",
            "| block | pixels / clock | latency (clocks) | window lead | clocks simulated | pixels compared bit-exact "
            "| same clocks, pixels / clock and latency on every simulator |",
            "|---|---:|---:|---|---:|---:|---|"]
@@ -372,7 +376,7 @@ def report(results: list[dict], sims: list[str] | None = None, versions: dict | 
         def vs(rate, cpu_rate):
             # against the bench of BEFORE_COMMIT where it ran (simulation time only: it reports no CPU
             # time), else against the per-clock drivers on today's design
-            ref = commit or before
+            ref = commit or before  # noqa: B023 (vs is called in this iteration only)
             if not (ref and ref["sim_s"] and rate):
                 return "-"
             text = f"{rate / (ref['cycles'] / ref['sim_s']):.2f}x"
@@ -493,9 +497,7 @@ def main(argv=None) -> int:
     results = [r for r in done if r["name"] in names and r["sim"] in sims]
     missing = [c[0] for c in cases if not any(r["name"] == c[0] for r in results)]
     text = report(results, sims, simulator_versions(), missing=missing) + NOTES + "\n" + synth_section(args.out)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(args.out, text)
-    print(text)
+    publish(text, args.out)
     return 0
 
 

@@ -20,7 +20,7 @@ import sys
 import time
 from pathlib import Path
 
-from eyestereo.tools.io import atomic_write_text
+from eyestereo.tools.reports import publish
 
 ROOT = Path(__file__).resolve().parents[2]
 SLOWEST = 15
@@ -47,7 +47,8 @@ def document(res: dict, jobs: int) -> str:
     m, s = divmod(round(res["wall"]), 60)
     cm, cs = divmod(round(res["cpu"]), 60)
     lines = ["# Time of `make test`", "",
-             f"Measured by `python -m eyestereo.sim.measure.suite_time` ({Path(__file__).name}) on {datetime.date.today()}: "
+             f"Measured by `python -m eyestereo.sim.measure.suite_time` ({Path(__file__).name}) "
+             f"on {datetime.date.today()}: "
              f"`pytest {res['cmd']}` as `make test` runs it, {os.cpu_count()} CPUs, "
              f"{platform.python_implementation()} {platform.python_version()}.", "",
              "| figure | value |", "|---|---:|",
@@ -75,10 +76,7 @@ def main(argv=None) -> int:
         print(f"suite_time: the suite failed (exit {res['rc']}); nothing written. Last lines:\n" +
               "\n".join(res["tail"]), file=sys.stderr)
         return 1
-    text = document(res, args.jobs)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(args.out, text)
-    print(text)
+    publish(document(res, args.jobs), args.out)
     return 0
 
 

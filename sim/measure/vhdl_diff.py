@@ -117,7 +117,8 @@ def convert_at(root: Path | None, configs, out: Path, imports=(), hdl: str = "VH
         d = out / str(n)
         shutil.rmtree(d, ignore_errors=True)
         d.mkdir(parents=True)
-        r = subprocess.run([sys.executable, "-c", _CONVERT, json.dumps([label, block, params, str(d), list(imports), hdl])],
+        args = json.dumps([label, block, params, str(d), list(imports), hdl])
+        r = subprocess.run([sys.executable, "-c", _CONVERT, args],
                            cwd=root or ROOT, env=env, capture_output=True, text=True)
         errors[label] = None if r.returncode == 0 else ((r.stderr or r.stdout).strip().splitlines() or ["failed"])[-1]
     return errors

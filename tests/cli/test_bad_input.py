@@ -125,7 +125,8 @@ def test_calibrate_refuses_one_camera_given_twice(capfd, box):
 
 
 def test_calibrate_refuses_swapped_cameras(capfd, box):
-    line = refused(capfd, box, 1, ["left camera is to the right of the right camera", "give the left camera's images first"],
+    line = refused(capfd, box, 1,
+                   ["left camera is to the right of the right camera", "give the left camera's images first"],
             "calibrate", box / "rig" / "right*.png", box / "rig" / "left*.png", "--square", "0.02", "-o",
             box / "out.yml")
     assert line.startswith("eyestereo: error: ")
@@ -308,7 +309,8 @@ def test_floating_point_images_are_refused(capfd, box):
     for argv in (["warp", box / "float.tiff", box / "maps.npz", "--side", "left", "-o", box / "w.png"],
                  ["evaluate", box / "float.tiff", box / "cam.png", box / "cam.png"]):
         r = refusal(capfd, box, *argv)
-        assert r.status == 1 and r.unchanged and r.says(["float.tiff holds floating-point pixels", "8- or 16-bit PNG"]), r
+        assert r.status == 1 and r.unchanged, r
+        assert r.says(["float.tiff holds floating-point pixels", "8- or 16-bit PNG"]), r
     r = refusal(capfd, box, "warp", box / "cam16.png", box / "maps.npz", "--side", "left", "-o", box / "w.jpg")
     assert r.status == 1 and r.unchanged and r.says("is 16-bit, which .jpg cannot hold"), r
 

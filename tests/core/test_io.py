@@ -89,7 +89,8 @@ def test_new_files_get_the_umask_mode_old_files_keep_theirs(tmp_path):
 # Output sets
 
 
-def test_outputs_commit_everything_or_nothing(tmp_path, umask022):
+@pytest.mark.usefixtures("umask022")
+def test_outputs_commit_everything_or_nothing(tmp_path):
     (tmp_path / "a.txt").write_text("old a")
     with pytest.raises(KeyboardInterrupt):
         with IO.Outputs() as out:

@@ -70,7 +70,7 @@ def test_library_words():
 
 def test_hdl_pack_and_unpack_convert_and_agree(tmp_path):
     """unpack_word then pack_word is the identity, in GHDL (VHDL-93c and 2008) and in Icarus (Verilog)."""
-    myhdl = pytest.importorskip("myhdl")
+    pytest.importorskip("myhdl")
     from myhdl import Signal, block, intbv
 
     from eyestereo.hdl.common.packed import pack_word, unpack_word

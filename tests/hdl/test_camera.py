@@ -16,6 +16,7 @@ import pytest
 from eyestereo.sim.lib.runner import run_bench
 from eyestereo.tools.camera import CameraTiming
 from eyestereo.tools.models.async_fifo import ClockSpec
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 
 pytestmark = pytest.mark.sim
 
@@ -177,12 +178,12 @@ def test_overflow_drops_and_counts_the_broken_frame(request, frames_hit):
 
 def test_full_cif_frame(request):
     """One 352x288 frame of a real colour image, 18 MHz into 100 MHz (short vertical blanking)."""
-    p = dict(width=352, height=288, order="YUYV", vsync_active=1, href_active=1, depth=1024)
+    p = dict(width=FRAME_WIDTH, height=FRAME_HEIGHT, order="YUYV", vsync_active=1, href_active=1, depth=1024)
     cfg = dict(timing=dict(h_blank=192, v_sync=1, v_back=1, v_front=1), rclk=[ps(100), 3000],
                cameras=[camera(frames=["file:tsukuba_im3.png"])])
     rep = _run("camera_interface", "tb_camera_interface", cfg, request, p)
     s = rep["sides"][0]
-    assert s["frames"] == [0] and s["words"] == 352 * 288 and s["edges_equal"] == s["words"]
+    assert s["frames"] == [0] and s["words"] == FRAME_WIDTH * FRAME_HEIGHT and s["edges_equal"] == s["words"]
 
 
 # --- camera_stream alone ---------------------------------------------------------------------------

@@ -122,7 +122,8 @@ def test_clock_reset_swapped():
 def test_stream_fields_tampered():
     s = ImageStream(8)
     s.data = Signal(intbv(0)[10:])
-    with pytest.raises(ValueError, match=r"port sink: its data field is a 10-bit unsigned Signal\(intbv\), the stream says 8"):
+    with pytest.raises(ValueError, match=r"port sink: its data field is a 10-bit unsigned Signal\(intbv\), "
+                                         r"the ImageStream says 8 bits"):
         check_stream("sink", s)
     s = ImageStream(8)
     s.valid = None

@@ -8,12 +8,12 @@ from myhdl import ResetSignal, Signal, intbv
 
 from eyestereo.hdl.flow.catalog import BLOCKS
 from eyestereo.hdl.interfaces.coord_pair import CoordPair
-from eyestereo.hdl.rectify.fetch_interpolate import fetch_interpolate
 from eyestereo.hdl.interfaces.fetch_port import FetchPort
-from eyestereo.hdl.rectify.rectifier import rectifier
 from eyestereo.hdl.interfaces.stream import ImageStream
+from eyestereo.hdl.rectify.calibration import calibration_param
+from eyestereo.hdl.rectify.fetch_interpolate import fetch_interpolate
+from eyestereo.hdl.rectify.rectifier import rectifier
 from eyestereo.tools.models import fetch_interpolate as fi
-from eyestereo.tools.models import poly_unit as unit
 
 SPEC = "seed:3:2@40x20"
 
@@ -152,7 +152,7 @@ def test_requests_reuse_and_frames():
 def test_rectifier_model_checks_images():
     from eyestereo.tools.models.rectifier import rectifier as model
 
-    cal = unit.Calibration.load(SPEC)
+    cal = calibration_param(SPEC)
     with pytest.raises(ValueError, match="left image is 40x20; the calibration was made for 352x288"):
         model(cal, np.zeros((20, 40), np.uint8), np.zeros((288, 352), np.uint8))
     with pytest.raises(ValueError, match="right image must be a 2-D uint8"):

@@ -8,6 +8,7 @@ import pytest
 
 from eyestereo.sim.lib.runner import fastest_ghdl_backend, fastest_simulator, run_bench
 from eyestereo.tools.models import harris_mono as hm
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH, K_CODE_DEFAULT, NMS_DEFAULT, THRESHOLD_BLOCKS
 
 pytestmark = pytest.mark.sim
 
@@ -36,7 +37,7 @@ def test_harris_window_random(request, duty, lim):
 
 
 def test_harris_window_real_image_full_frame(request):
-    _run("harris_window", "tb_harris_window", dict(width=352, height=288),
+    _run("harris_window", "tb_harris_window", dict(width=FRAME_WIDTH, height=FRAME_HEIGHT),
          dict(frames=["sobel:file:tsukuba_im3.png"], duty=1.0), request, backend=FULL)
 
 
@@ -78,7 +79,7 @@ def test_prethreshold_reset_clears_thresholds(request):
 
 
 def test_prethreshold_full_frame(request):
-    _run("prethreshold", "tb_prethreshold", dict(width=352, height=288, blocks=(4, 4)),
+    _run("prethreshold", "tb_prethreshold", dict(width=FRAME_WIDTH, height=FRAME_HEIGHT, blocks=THRESHOLD_BLOCKS),
          dict(frames=["rcorner:6:-1000:1000"], duty=1.0, thresholds=THR_4X4), request)
 
 
@@ -97,13 +98,12 @@ def test_nms_smallest_frame(request, size):
 
 
 # --- harris_mono -----------------------------------------------------------------------------------
-K04 = hm.k_code(0.04)
 THR_TSUKUBA = [hm.threshold_code(c) for c in (2e8, 4e8, 1e8, 6e8, 3e8, 1e9, 5e7, 2e8,
                                               8e8, 1e8, 3e8, 4e8, 6e8, 2e8, 1e8, 5e8)]
 
 
 @pytest.mark.parametrize("nms", [1, 3, 5])
-@pytest.mark.parametrize("k", [K04, hm.k_code(0.1)])
+@pytest.mark.parametrize("k", [K_CODE_DEFAULT, hm.k_code(0.1)])
 def test_harris_mono_random_small(request, nms, k):
     _run("harris_mono", "tb_harris_mono", dict(width=40, height=30, blocks=(2, 2), nms=nms),
          dict(frames=["random:1", "random:2"], duty=0.5, seed=nms, k=k, thresholds=[0, 5, 100, -3], token_after=90),
@@ -115,7 +115,7 @@ def test_harris_mono_fast_numeric_std(request):
     speed benchmark's fastest GHDL column uses): bit-exact with the model, reset token and idle cycles
     included (tests/hdl/test_ghdl_ieee.py compares the library itself with IEEE's)."""
     rep = _run("harris_mono", "tb_harris_mono", dict(width=48, height=36, blocks=(2, 2), nms=3),
-               dict(frames=["random:5", "file:tsukuba_im3.png", "random:6"], duty=0.6, seed=7, k=K04,
+               dict(frames=["random:5", "file:tsukuba_im3.png", "random:6"], duty=0.6, seed=7, k=K_CODE_DEFAULT,
                     thresholds=[0, 5, 100, -3], token_after=120, drivers="hdl", ieee="fast"), request)
     assert rep["pixels_compared"] == 3 * (48 - 8) * (36 - 8)  # every pixel the model specifies (4 px border)
 
@@ -131,19 +131,20 @@ def test_harris_mono_full_frames_4x4_nms3(request):
     On the fastest simulator (Verilator when installed), as the next one: the VHDL runs full frames in
     test_harris_mono_full_frame_nms1, and
     tests/hdl/test_simulators.py checks GHDL, Icarus and Verilator give the same words on full frames."""
-    _run("harris_mono", "tb_harris_mono", dict(width=352, height=288, blocks=(4, 4), nms=3),
-         dict(frames=["file:tsukuba_im3.png", "file:chessboard_left01.jpg"], duty=1.0, k=K04,
+    _run("harris_mono", "tb_harris_mono",
+         dict(width=FRAME_WIDTH, height=FRAME_HEIGHT, blocks=THRESHOLD_BLOCKS, nms=NMS_DEFAULT),
+         dict(frames=["file:tsukuba_im3.png", "file:chessboard_left01.jpg"], duty=1.0, k=K_CODE_DEFAULT,
               thresholds=THR_TSUKUBA, token_after=3000), request, sim=fastest_simulator())
 
 
 def test_harris_mono_full_frame_global_nms5_gaps(request):
-    _run("harris_mono", "tb_harris_mono", dict(width=352, height=288, blocks=(1, 1), nms=5),
+    _run("harris_mono", "tb_harris_mono", dict(width=FRAME_WIDTH, height=FRAME_HEIGHT, blocks=(1, 1), nms=5),
          dict(frames=["file:chessboard_left01.jpg"], duty=0.6, seed=5, k=hm.k_code(0.06),
               thresholds=[hm.threshold_code(2e8)]), request, sim=fastest_simulator())
 
 
 def test_harris_mono_full_frame_nms1(request):
-    _run("harris_mono", "tb_harris_mono", dict(width=352, height=288, blocks=(4, 4), nms=1),
+    _run("harris_mono", "tb_harris_mono", dict(width=FRAME_WIDTH, height=FRAME_HEIGHT, blocks=THRESHOLD_BLOCKS, nms=1),
          dict(frames=["file:tsukuba_im3.png"], duty=1.0, k=hm.k_code(0.05), thresholds=THR_TSUKUBA), request,
          backend=FULL)
 
@@ -151,5 +152,5 @@ def test_harris_mono_full_frame_nms1(request):
 def test_harris_mono_test_pattern_in_hardware(request):
     """The checkerboard test pattern through the hardware: the same flags as the model, bit for bit
     (on the fastest simulator; the VHDL's full frames: test_harris_mono_full_frame_nms1)."""
-    _run("harris_mono", "tb_harris_mono", dict(width=352, height=288, blocks=(1, 1), nms=5),
+    _run("harris_mono", "tb_harris_mono", dict(width=FRAME_WIDTH, height=FRAME_HEIGHT, blocks=(1, 1), nms=5),
          dict(frames=["checker:1"], duty=1.0, k=hm.k_code(0.24), thresholds=[13]), request, sim=fastest_simulator())

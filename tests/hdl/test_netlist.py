@@ -12,6 +12,7 @@ import pytest
 from eyestereo.hdl.flow.netlist import NetlistError, fix_arithmetic_shifts, lint_vhdl, patch_pmux_defaults, repair, \
     vhdl_select_defaults
 from eyestereo.tools.models import harris_mono as hm
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH, K_CODE_DEFAULT, NMS_DEFAULT, THRESHOLD_BLOCKS
 
 needs_tools = pytest.mark.skipif(shutil.which("ghdl") is None or shutil.which("iverilog") is None,
                                  reason="GHDL and Icarus Verilog needed")
@@ -109,7 +110,7 @@ CASES = {
                      dict(frames=["rcorner:1:-600:600"], thresholds={i: (i * 37 % 23 - 11) * 40 for i in range(16)})),
     "nms": ("tb_nms", dict(SMALL, size=5), dict(frames=["rcorner:1:-2:3", "rcorner:2:-1:1"])),
     "harris_mono": ("tb_harris_mono", dict(width=40, height=30, blocks=(4, 4), nms=3),
-                    dict(frames=["random:1", "random:2"], k=hm.k_code(0.04),
+                    dict(frames=["random:1", "random:2"], k=K_CODE_DEFAULT,
                          thresholds=[0, 5, 100, -3, 7, 1, 0, 2, 9, 0, 3, 1, 4, 4, 0, 8])),
 }
 
@@ -150,5 +151,6 @@ def test_harris_mono_netlist_full_frame(request):
     """The whole mono Harris as make synth measures it, on a real 352x288 frame, 16 block thresholds."""
     thr = [hm.threshold_code(c) for c in (2e8, 4e8, 1e8, 6e8, 3e8, 1e9, 5e7, 2e8,
                                           8e8, 1e8, 3e8, 4e8, 6e8, 2e8, 1e8, 5e8)]
-    _run("harris_mono", "tb_harris_mono", dict(width=352, height=288, blocks=(4, 4), nms=3),
-         dict(frames=["file:tsukuba_im3.png"], duty=1.0, k=hm.k_code(0.04), thresholds=thr), request)
+    _run("harris_mono", "tb_harris_mono",
+         dict(width=FRAME_WIDTH, height=FRAME_HEIGHT, blocks=THRESHOLD_BLOCKS, nms=NMS_DEFAULT),
+         dict(frames=["file:tsukuba_im3.png"], duty=1.0, k=K_CODE_DEFAULT, thresholds=thr), request)

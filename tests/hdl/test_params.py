@@ -219,7 +219,7 @@ def test_catalog_default_configuration_elaborates(name):
     assert p == spec.params()
     if spec.build is not None:  # multi-clock and camera blocks: their ports are checked in test_camera_params
         return
-    assert set(ports_) == {"clk", "rst", "sink", "source"} | {n for n, _ in spec.control}
+    assert set(ports_) == {"clk", "rst", "sink", "source"} | set(spec.control_names())
     # ImageStream and AxiStream both carry data_width (an AxiStream pads tdata to whole bytes)
     assert ports_["sink"].data_width == spec.sink_width(spec.params())
     assert ports_["source"].data_width == spec.source_width(spec.params())
@@ -269,7 +269,7 @@ def _call(spec, ports, kw):
 
 
 def _port_names(spec):
-    return ["clk", "rst", "sink", "source"] + [n for n, _ in spec.control]
+    return ["clk", "rst", "sink", "source"] + spec.control_names(**_small(spec))
 
 
 def _expect(name, match, spec, ports, kw):
@@ -282,44 +282,44 @@ def _expect(name, match, spec, ports, kw):
     return msg
 
 
+def _expect_port(name, port, value, match):
+    """Block ``name`` in its small configuration with ``value`` on ``port`` (the other ports as the catalog
+    makes them): refused with a message matching ``match``."""
+    spec = BLOCKS[name]
+    ports, kw, _ = spec.ports(**_small(spec))
+    ports[port] = value
+    _expect(name, match, spec, ports, kw)
+
+
 BAD_PORT_VALUES = {
-    "None": (lambda ports, n: None, r"got None"),
-    "int": (lambda ports, n: 1, r"got int 1"),
-    "str": (lambda ports, n: n, r"got str"),
+    "None": (lambda port: None, r"got None"),
+    "int": (lambda port: 1, r"got int 1"),
+    "str": (lambda port: port, r"got str"),
 }
 
 
 @pytest.mark.parametrize("bad", sorted(BAD_PORT_VALUES))
 @pytest.mark.parametrize("name", STANDARD)
 def test_every_port_refuses_none_int_str(name, bad):
-    spec = BLOCKS[name]
     make, match = BAD_PORT_VALUES[bad]
-    for port in _port_names(spec):
-        ports, kw, _ = spec.ports(**_small(spec))
-        ports[port] = make(ports, port)
-        _expect(name, rf"port {port} .*{match}", spec, ports, kw)
+    for port in _port_names(BLOCKS[name]):
+        _expect_port(name, port, make(port), rf"port {port} .*{match}")
 
 
 @pytest.mark.parametrize("name", STANDARD)
 def test_reset_must_be_synchronous_active_high_reset_signal(name):
-    spec = BLOCKS[name]
     for rst, match in ((Signal(bool(0)), r"port rst must be a ResetSignal\(0, active=1, isasync=False\), got a Signal"),
                        (ResetSignal(0, active=1, isasync=True), r"port rst is an asynchronous reset"),
                        (ResetSignal(1, active=0, isasync=False), r"port rst is an active-low reset"),
                        (ResetSignal(1, active=0, isasync=True), r"port rst is an asynchronous active-low reset")):
-        ports, kw, _ = spec.ports(**_small(spec))
-        ports["rst"] = rst
-        _expect(name, match, spec, ports, kw)
+        _expect_port(name, "rst", rst, match)
 
 
 @pytest.mark.parametrize("name", STANDARD)
 def test_clock_must_be_a_bool_signal(name):
-    spec = BLOCKS[name]
     for clk, match in ((Signal(intbv(0)[1:]), r"port clk must be a 1-bit Signal\(bool\(0\)\), got a 1-bit unsigned"),
                        (ResetSignal(0, active=1, isasync=False), r"port clk must be the clock.*swapped")):
-        ports, kw, _ = spec.ports(**_small(spec))
-        ports["clk"] = clk
-        _expect(name, match, spec, ports, kw)
+        _expect_port(name, "clk", clk, match)
 
 
 @pytest.mark.parametrize("name", STANDARD)
@@ -331,10 +331,8 @@ def test_streams_and_control_ports_swapped(name):
         kind = type(ports[port]).__name__  # ImageStream, or AxiStream for the bridges' AXI side
         ports[port] = Signal(intbv(0)[8:])
         _expect(name, rf"port {port} must be an {kind}, got an 8-bit unsigned Signal", spec, ports, kw)
-    for port, _ in spec.control:
-        ports, kw, _ = spec.ports(**_small(spec))
-        ports[port] = ImageStream(8)
-        _expect(name, rf"port {port} must be a MyHDL Signal, got an ImageStream", spec, ports, kw)
+    for port in spec.control_names(**_small(spec)):
+        _expect_port(name, port, ImageStream(8), rf"port {port} must be a MyHDL Signal, got an ImageStream")
 
 
 @pytest.mark.parametrize("name", STANDARD)
@@ -351,7 +349,7 @@ def test_wrong_stream_widths(name):
 @pytest.mark.parametrize("name", STANDARD)
 def test_control_port_widths_and_kinds(name):
     spec = BLOCKS[name]
-    for port, _ in spec.control:
+    for port in spec.control_names(**_small(spec)):
         ports, kw, _ = spec.ports(**_small(spec))
         n = 1 if isinstance(ports[port].val, bool) else len(ports[port])
         if port == "thr_addr":  # at least log2(blocks) bits: more are fine, fewer are not
@@ -510,7 +508,8 @@ def test_composite_block_names_itself_not_an_inner_block():
 
 
 def test_window_machinery_checks_its_arguments():
-    from eyestereo.hdl.common import column_taps, delay, window_control
+    from eyestereo.hdl.common import delay
+    from eyestereo.hdl.streaming.window import column_taps, window_control
 
     clk, rst = ports()
     with pytest.raises(ValueError, match=r"column_taps: taps must be a list of at least 2 Signals"):
@@ -518,9 +517,12 @@ def test_window_machinery_checks_its_arguments():
     with pytest.raises(ValueError, match=r"column_taps: port taps\[1\] must be 8 bits wide, got 9"):
         column_taps(clk, rst, ImageStream(8), [Signal(intbv(0)[8:]), Signal(intbv(0)[9:])], Signal(bool(0)),
                     width=8, height=4)
-    with pytest.raises(ValueError, match=r"column_taps: port sink is a stereo stream"):
-        column_taps(clk, rst, ImageStream(8, stereo=True), [Signal(intbv(0)[8:])] * 2, Signal(bool(0)),
-                    width=8, height=4)
+    # one machinery for both kinds of stream: the source must be of the sink's kind, share needs stereo
+    with pytest.raises(ValueError, match=r"window_control: port source must be a stereo stream"):
+        window_control(clk, rst, ImageStream(8, stereo=True), ImageStream(8), width=8, height=4, radius=1,
+                       latency=3)
+    with pytest.raises(ValueError, match=r"window_control: .*share.*stereo"):
+        window_control(clk, rst, ImageStream(8), ImageStream(8), width=8, height=4, radius=1, latency=3, share=2)
     with pytest.raises(ValueError, match=r"window_control: parameter radius must be an integer, got float"):
         window_control(clk, rst, ImageStream(8), ImageStream(8), width=8, height=4, radius=1.0, latency=3)
     with pytest.raises(ValueError, match=r"window_control: parameter latency=0 is too small: at least 1"):
@@ -531,3 +533,24 @@ def test_window_machinery_checks_its_arguments():
         delay(clk, Signal(bool(0)), Signal(bool(0)), clocks=2.0)
     assert window_control(clk, rst, ImageStream(8), ImageStream(8), width=np.int64(8), height=np.int64(4),
                           radius=np.int64(1), latency=np.int64(3)) is not None
+
+
+def test_catalog_defaults_are_the_blocks_own():
+    """Every block parameter's catalogue default is the block function's keyword default, except the ones
+    the catalogue states on purpose (written out here)."""
+    import inspect
+
+    stated = {("convolve", "col"), ("convolve", "row"), ("convolve", "shift"), ("harris_stereo", "share"),
+              ("poly_unit", "quantizers"), ("coordinate_warper", "quantizers"), ("rectifier", "quantizers")}
+    for name, spec in BLOCKS.items():
+        sig = inspect.signature(spec.func).parameters
+        own = {k: v.default for k, v in sig.items() if v.kind is v.KEYWORD_ONLY}
+        assert set(spec.hw_params) == set(own), name
+        for k, v in own.items():
+            if (name, k) not in stated:
+                assert spec.defaults[k] == v, (name, k)
+        # the port list is the block's positional parameters, in order (optional ones may be left out)
+        ports, _, _ = spec.ports()
+        positional = [k for k, v in sig.items() if v.kind is not v.KEYWORD_ONLY]
+        assert list(ports) == positional[:len(ports)], name
+    assert BLOCKS["harris_stereo"].defaults["share"] == 3 and BLOCKS["convolve"].defaults["shift"] == 4

@@ -6,6 +6,7 @@ from myhdl import ResetSignal, Signal, intbv
 
 from eyestereo.hdl.flow.catalog import BLOCKS
 from eyestereo.hdl.interfaces.coord_pair import CoordPair
+from eyestereo.hdl.rectify.calibration import calibration_param
 from eyestereo.hdl.rectify.coordinate_warper import coordinate_warper
 from eyestereo.hdl.rectify.poly_unit import CoefPort, poly_unit
 from eyestereo.tools.models import poly_unit as unit
@@ -15,7 +16,7 @@ SPEC = "seed:3:2@40x20"
 
 @pytest.fixture(scope="module")
 def cal():
-    return unit.Calibration.load(SPEC)
+    return calibration_param(SPEC)
 
 
 def unit_ports(cal, frac=5, **over):

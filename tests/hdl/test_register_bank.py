@@ -92,8 +92,8 @@ def test_register_bank_verilog_on_icarus(request):
     """MyHDL's Verilog back end can differ from its VHDL one: the same bench on the Verilog, in Icarus."""
     from eyestereo.sim.lib.sram_runner import run_sram_bench
 
-    rep = run_sram_bench("register_bank", "tb_register_bank", dict(seed=5, pause=0.2, salts=1, full=False, rw_writes=15),
-                         name=request.node.name,
+    rep = run_sram_bench("register_bank", "tb_register_bank",
+                         dict(seed=5, pause=0.2, salts=1, full=False, rw_writes=15), name=request.node.name,
                          params=dict(width=64, height=48), sim="icarus")
     assert rep["counts"]["ar"] > 150
 
@@ -120,3 +120,59 @@ def test_host_driver_on_the_sram_subsystem(request):
     rep = run_bench("host_system_tb", "tb_host_system", dict(seed=2, pause=0.2), name=request.node.name,
                     params=dict(width=16, height=4, feature_words=64))
     assert rep["arb"]["moved_cam0"] == 64 and rep["host_moves"] == 24 + 64
+
+
+# ---- frame_handshake: the host's frame-handshake fields wired to the arbiter (system top and bench top) ---
+def test_frame_handshake_fields():
+    """The fields docs/registers.md ("Connections") wires to FrameControl, and which way each goes."""
+    from eyestereo.hdl.system.frame_handshake import HANDSHAKE
+
+    assert dict(HANDSHAKE) == {"rect_want": True, "feat_want": True, "rect_release": True, "feat_release": True,
+                               "avail": False, "rect_held": False, "feat_held": False, "rect_buf": False,
+                               "feat_buf": False}
+
+
+def test_frame_handshake_wires_each_field():
+    """In MyHDL's simulator: a value on each bank output appears on the arbiter's member, a value on each
+    arbiter output on the bank's status field; nothing else moves."""
+    from myhdl import Simulation, delay, instance
+
+    from eyestereo.hdl.memory.frame_buffers import FrameControl
+    from eyestereo.hdl.system.frame_handshake import frame_handshake
+
+    regs, ctl = RegisterPorts(), FrameControl()
+    dut = frame_handshake(regs, ctl)
+    to_arbiter = ("rect_want", "feat_want", "rect_release", "feat_release")
+    from_arbiter = {"avail": 0b1010, "rect_held": 1, "feat_held": 1, "rect_buf": 1, "feat_buf": 1}
+    seen = {}
+
+    @instance
+    def stim():
+        for name in to_arbiter:
+            getattr(regs, name).next = 1
+            yield delay(1)
+            seen[name] = [int(getattr(ctl, n)) for n in to_arbiter]
+            getattr(regs, name).next = 0
+            yield delay(1)
+        for name, value in from_arbiter.items():
+            getattr(ctl, name).next = value
+            yield delay(1)
+            seen[name] = int(getattr(regs, name))
+        seen["cam"] = (int(ctl.cam_want), int(ctl.cam_release))
+
+    Simulation(dut, stim).run(quiet=1)
+    for i, name in enumerate(to_arbiter):
+        assert seen[name] == [int(j == i) for j in range(4)], name
+    for name, value in from_arbiter.items():
+        assert seen[name] == value, name
+    assert seen["cam"] == (0, 0)
+
+
+def test_frame_handshake_refuses_other_bundles():
+    from eyestereo.hdl.memory.frame_buffers import FrameControl
+    from eyestereo.hdl.system.frame_handshake import frame_handshake
+
+    with pytest.raises(ValueError, match=r"^frame_handshake: port ctl must be a FrameControl"):
+        frame_handshake(RegisterPorts(), HostPort())
+    with pytest.raises(ValueError, match=r"^frame_handshake: port regs must be a RegisterPorts"):
+        frame_handshake(FrameControl(), FrameControl())

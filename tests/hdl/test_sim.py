@@ -9,15 +9,12 @@ pixel whose window lies inside the image, frame and token counts, and that nothi
 import pytest
 
 from eyestereo.sim.lib.runner import run_bench
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 
 pytestmark = pytest.mark.sim
 
 SMALL = dict(width=17, height=9)
 DUTIES = [1.0, 0.5, 0.1]
-
-
-def _id(d):
-    return "-".join(f"{k}{v}" for k, v in d.items() if not isinstance(v, (list, tuple)))
 
 
 def _run(block, bench, params, stim, request):
@@ -44,7 +41,7 @@ def test_line_delay_tiny(request, geometry):
 
 
 def test_line_delay_full_frame(request):
-    _run("line_delay", "tb_line_delay", dict(width=352, height=288, data_width=8),
+    _run("line_delay", "tb_line_delay", dict(width=FRAME_WIDTH, height=FRAME_HEIGHT, data_width=8),
          dict(frames=["file:chessboard_left01.jpg"], duty=1.0), request)
 
 
@@ -75,7 +72,7 @@ def test_convolve_smallest_frame(request, kernel, size):
 
 
 def test_convolve_full_frame(request):
-    _run("convolve", "tb_convolve", dict(width=352, height=288, **KERNELS["sep5"]),
+    _run("convolve", "tb_convolve", dict(width=FRAME_WIDTH, height=FRAME_HEIGHT, **KERNELS["sep5"]),
          dict(frames=["file:tsukuba_im3.png"], duty=1.0), request)
 
 
@@ -88,12 +85,12 @@ def test_sobel_random(request, seed, duty):
 
 
 def test_sobel_full_frames_back_to_back(request):
-    _run("sobel", "tb_sobel", dict(width=352, height=288),
+    _run("sobel", "tb_sobel", dict(width=FRAME_WIDTH, height=FRAME_HEIGHT),
          dict(frames=["file:tsukuba_im3.png", "file:chessboard_left01.jpg"], duty=1.0, token_after=1000), request)
 
 
 def test_sobel_full_frame_gaps(request):
-    _run("sobel", "tb_sobel", dict(width=352, height=288),
+    _run("sobel", "tb_sobel", dict(width=FRAME_WIDTH, height=FRAME_HEIGHT),
          dict(frames=["file:chessboard_left01.jpg"], duty=0.5, seed=7), request)
 
 

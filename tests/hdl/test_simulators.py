@@ -24,6 +24,7 @@ from eyestereo.hdl.flow.vlint import mixed_signedness
 from eyestereo.sim.lib import runner
 from eyestereo.sim.lib.runner import build_dir_of, run_bench, simulator
 from eyestereo.tools.models import harris_mono as hm
+from eyestereo.tools.constants import K_CODE_DEFAULT
 
 have_icarus = shutil.which("iverilog") is not None
 have_verilator = runner.verilator_root() is not None
@@ -108,7 +109,7 @@ def test_make_verilog_every_block(tmp_path):
 # --- three simulators, one stimulus, the same words -------------------------------------------------
 THREE = {
     "harris_mono": ("harris_mono", "tb_harris_mono", dict(width=48, height=40, blocks=(2, 2), nms=3),
-                    dict(frames=["random:1", "pattern:2"], duty=0.6, seed=4, k=hm.k_code(0.04),
+                    dict(frames=["random:1", "pattern:2"], duty=0.6, seed=4, k=K_CODE_DEFAULT,
                          thresholds=[0, 5, 100, -3], token_after=90)),
     "cornerness": ("cornerness", "tb_cornerness", dict(width=23, height=13),
                    dict(frames=["rwindow:1", "rwindow:2"], duty=0.5, k=61, token_after=50)),
@@ -211,7 +212,7 @@ def test_ghdl_vhdl_netlist_same_words_as_vhdl(tmp_path):
     """harris_mono as GHDL's own synthesized VHDL netlist, on GHDL with the HDL drivers: the bench's model
     checks pass (bit for bit) and every output word equals the VHDL's, border pixels included."""
     params = dict(width=40, height=24, blocks=(2, 2), nms=3)
-    stim = dict(frames=["random:1", "random:5"], duty=0.7, seed=3, k=10, thresholds=[40, 10, 60, 0])
+    stim = dict(frames=["random:1", "random:5"], duty=0.7, seed=3, k=K_CODE_DEFAULT, thresholds=[40, 10, 60, 0])
     words = {}
     for design, drv in (("vhdl", "events"), ("netlist", "hdl")):
         dump = tmp_path / f"{design}.npy"

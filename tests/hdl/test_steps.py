@@ -18,8 +18,8 @@ def test_each_step_prints_one_line_and_logs_the_rest(tmp_path):
     def noisy():
         print("simulator banner\n" * 50)
         print("warning from python", file=sys.stderr)
-        subprocess.run([sys.executable, "-c", "import sys; print('child says hi'); print('child err', file=sys.stderr)"],
-                       check=True)
+        child = "import sys; print('child says hi'); print('child err', file=sys.stderr)"
+        subprocess.run([sys.executable, "-c", child], check=True)
         return 42, "1234 pixels bit-exact -> a.png"
 
     assert steps.run("sobel", noisy) == 42

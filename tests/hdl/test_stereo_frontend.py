@@ -36,7 +36,8 @@ def test_stereo_frontend(request, mode):
     rep = run_bench("stereo_frontend", "tb_stereo_frontend",
                     dict(mode=mode, frames=FRAMES[mode], images="shift:3", timing=TIMING, require_features=True,
                          pause=0.1 if mode == "sequential" else 0.0,
-                         # sequential: the host closes the threshold loop (thesis 7.2), a quarter feature per block wanted
+                         # sequential: the host closes the threshold loop (thesis 7.2), a quarter feature per
+                         # block wanted
                          adaptive=0.25 if mode == "sequential" else None),
                     name=request.node.name, params=dict(quantizers=SPEC, feature_words=256, max_features=127))
     n = FRAMES[mode]
@@ -54,7 +55,7 @@ def test_stereo_frontend(request, mode):
 
 def test_model_is_the_chain():
     """The system model is the composition of the block models (spot check on one frame)."""
-    from eyestereo.hdl.rectify.poly_unit import calibration_param
+    from eyestereo.hdl.rectify.calibration import calibration_param
     from eyestereo.sim.lib.camera import camera_frame
     from eyestereo.tools.models import harris_stereo, rectifier
 

@@ -1,7 +1,6 @@
 """make vhdl: every block's default configuration converts, analyses in GHDL (93c and 08), has a manifest."""
 
 import json
-import re
 import shutil
 import subprocess
 import sys
@@ -9,6 +8,7 @@ from pathlib import Path
 
 import pytest
 from myhdl import ResetSignal, Signal
+from myhdl._Signal import _Signal
 
 from eyestereo.hdl.flow.catalog import BLOCKS
 from eyestereo.hdl.flow.convert import GHDL_STDS, analyse, make_vhdl, vhdl_ports
@@ -16,6 +16,20 @@ from eyestereo.hdl.streaming.line_delay import line_delay
 from eyestereo.hdl.interfaces.stream import ImageStream
 
 needs_ghdl = pytest.mark.skipif(shutil.which("ghdl") is None, reason="GHDL not installed")
+
+
+def _port_names(ports: dict) -> list[str]:
+    """HDL port names of a block's ports: a bundle as ``<arg>_<field>`` (its declared fields; an undeclared
+    bundle such as BufferSide: its Signal attributes)."""
+    names = []
+    for n, port in ports.items():
+        if isinstance(port, _Signal):
+            names.append(n)
+        else:
+            fields = (port.fields() if hasattr(port, "fields")
+                      else [k for k, v in vars(port).items() if isinstance(v, _Signal)])
+            names += [f"{n}_{f}" for f in fields]
+    return names
 
 
 @needs_ghdl
@@ -29,12 +43,15 @@ def test_make_vhdl_writes_and_analyses_every_block(tmp_path):
     for b in manifest["blocks"]:
         assert (tmp_path / f"{b['entity']}.vhd").exists()
         assert b["files"][0] == manifest["package"]
+        # every block: the entity's ports are the catalogue's ports, bundles expanded by their declarations
+        _, all_ports, _ = BLOCKS[b["entity"]].elaborate()
+        assert sorted(p["name"] for p in b["ports"]) == sorted(_port_names(all_ports)), b["entity"]
         if BLOCKS[b["entity"]].build is not None:  # own port lists: tests/hdl/test_camera_params.py
             continue
         names = [p["name"] for p in b["ports"]]
         spec = BLOCKS[b["entity"]]
-        control = [n for n, _ in spec.control]
         _, ports, _ = spec.elaborate()
+        control = [n for n in ports if n not in ("clk", "rst", "sink", "source")]  # in the block's call order
         # MyHDL lists plain signal ports (clk, rst, control) before the flattened stream interfaces.
         assert names == ["clk", "rst"] + control + [f"sink_{f}" for f in ports["sink"].fields()] + \
             [f"source_{f}" for f in ports["source"].fields()]
@@ -77,7 +94,8 @@ def test_stereo_stream_has_cam_ports(tmp_path):
 
 
 def test_vhdl_ports_parser_reads_directions():
-    text = "entity x is\n    port (\n        a: in std_logic;\n        b: out unsigned(3 downto 0)\n    );\nend entity x;\n"
+    text = ("entity x is\n    port (\n        a: in std_logic;\n        b: out unsigned(3 downto 0)\n    );\n"
+            "end entity x;\n")
     import pathlib
     import tempfile
 

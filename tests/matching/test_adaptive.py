@@ -11,8 +11,10 @@ import pytest
 import eyestereo.tools
 from eyestereo.tools.matching import adaptive as A
 from eyestereo.tools.models import harris_mono as hm
+from eyestereo.tools.constants import K_CODE_DEFAULT
 
-DATA = Path(os.environ.get("EYESTEREO_SHARED", Path(eyestereo.tools.__file__).resolve().parents[1].parent / "shared")) / "data" / "middlebury"
+SHARED = Path(os.environ.get("EYESTEREO_SHARED", Path(eyestereo.tools.__file__).resolve().parents[1].parent / "shared"))
+DATA = SHARED / "data" / "middlebury"
 needs_middlebury = pytest.mark.skipif(not (DATA / "tsukuba" / "im3.png").is_file(),
                                       reason=f"Middlebury images not found at {DATA}")
 
@@ -121,9 +123,9 @@ def test_closed_loop_on_real_frames():
     assert h.codes.shape == (16, 16) and h.counts.shape == (16, 16)
     assert h.codes[0].tolist() == [0] * 16                       # after reset
     # the loop's record is consistent with the bit-true model
-    f, m = hm.harris_mono(frames[5], hm.k_code(0.04), h.codes[5])
+    f, m = hm.harris_mono(frames[5], K_CODE_DEFAULT, h.codes[5])
     assert A.block_counts(f, m).tolist() == h.counts[5].tolist()
-    cap = A.block_counts(*hm.harris_mono(frames[7], hm.k_code(0.04), [0] * 16))
+    cap = A.block_counts(*hm.harris_mono(frames[7], K_CODE_DEFAULT, [0] * 16))
     reach = np.minimum(cap, target).sum()
     assert abs(h.totals[0] - reach) > 0.5 * reach                 # far off at first
     assert abs(h.totals[7] - reach) <= 0.2 * reach                # settled before the step

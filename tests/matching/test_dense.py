@@ -14,7 +14,8 @@ from eyestereo.tools.matching import dense as D
 from eyestereo.tools.matching import sparse as M
 from eyestereo.tools.matching import metrics as Q
 
-DATA = Path(os.environ.get("EYESTEREO_SHARED", Path(eyestereo.tools.__file__).resolve().parents[1].parent / "shared")) / "data" / "middlebury"
+SHARED = Path(os.environ.get("EYESTEREO_SHARED", Path(eyestereo.tools.__file__).resolve().parents[1].parent / "shared"))
+DATA = SHARED / "data" / "middlebury"
 needs_middlebury = pytest.mark.skipif(not (DATA / "tsukuba" / "im3.png").is_file(),
                                       reason=f"Middlebury images not found at {DATA}")
 
@@ -58,7 +59,8 @@ def test_equals_a_loop_reference():
     Li, Ri = L.astype(int), R.astype(int)
     for y in range(r, 20 - r):
         for x in range(r, 30 - r):
-            costs = [(np.abs(Li[y - r:y + r + 1, x - r:x + r + 1] - Ri[y - r:y + r + 1, x - d - r:x - d + r + 1]).sum(), d)
+            costs = [(np.abs(Li[y - r:y + r + 1, x - r:x + r + 1]
+                             - Ri[y - r:y + r + 1, x - d - r:x - d + r + 1]).sum(), d)
                      for d in range(dmin, dmax + 1) if x - d - r >= 0]
             exp = min(costs)[1] if costs else np.nan
             assert (np.isnan(exp) and np.isnan(got[y, x])) or got[y, x] == exp, (x, y)

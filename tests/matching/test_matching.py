@@ -19,8 +19,10 @@ import eyestereo.tools
 from eyestereo.tools.models import harris_mono as hm
 from eyestereo.tools.matching import sparse as M
 from eyestereo.tools.matching import metrics as Q
+from eyestereo.tools.constants import K_CODE_DEFAULT
 
-DATA = Path(os.environ.get("EYESTEREO_SHARED", Path(eyestereo.tools.__file__).resolve().parents[1].parent / "shared")) / "data" / "middlebury"
+SHARED = Path(os.environ.get("EYESTEREO_SHARED", Path(eyestereo.tools.__file__).resolve().parents[1].parent / "shared"))
+DATA = SHARED / "data" / "middlebury"
 needs_middlebury = pytest.mark.skipif(not (DATA / "tsukuba" / "im3.png").is_file(),
                                       reason=f"Middlebury images not found at {DATA}")
 
@@ -41,7 +43,7 @@ def shifted_pair(h=64, w=96, d=6, seed=0, offset=0):
 
 
 def corners(img, code=0):
-    flags, mask = hm.harris_mono(img, hm.k_code(0.04), [code] * 16)
+    flags, mask = hm.harris_mono(img, K_CODE_DEFAULT, [code] * 16)
     return hm.features(flags, mask)
 
 

@@ -13,7 +13,8 @@ import pytest
 import eyestereo.tools
 from eyestereo.tools.matching import metrics as Q
 
-DATA = Path(os.environ.get("EYESTEREO_SHARED", Path(eyestereo.tools.__file__).resolve().parents[1].parent / "shared")) / "data" / "middlebury"
+SHARED = Path(os.environ.get("EYESTEREO_SHARED", Path(eyestereo.tools.__file__).resolve().parents[1].parent / "shared"))
+DATA = SHARED / "data" / "middlebury"
 needs_middlebury = pytest.mark.skipif(not (DATA / "tsukuba" / "disp3.pgm").is_file(),
                                       reason=f"Middlebury ground truth not found at {DATA}")
 

@@ -17,6 +17,7 @@ from eyestereo.tools.models import harris_window as hw
 from eyestereo.tools.models import nms as nm
 from eyestereo.tools.models import prethreshold as pt
 from eyestereo.tools.testpattern import checkerboard_pattern, corner_pattern, match_corners
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH, K_CODE_DEFAULT, K_DEFAULT
 
 W, H = 64, 48
 
@@ -94,6 +95,7 @@ def test_positive_side_cannot_saturate_from_any_sobel_window():
 
 
 def test_k_and_threshold_codes():
+    assert hm.k_code(K_DEFAULT) == K_CODE_DEFAULT  # the shared constants agree
     assert hm.k_code(0.04) == 10 and hm.k_code(0) == 0 and hm.k_code(255 / 256) == 255
     for bad in (-0.01, 1.0, 2):
         with pytest.raises(ValueError, match="k port"):
@@ -105,11 +107,11 @@ def test_k_and_threshold_codes():
 
 
 def test_float_units_match_the_codes_on_a_real_image():
-    img = make_frame("file:tsukuba_im3.png", 352, 288)
-    k = hm.k_code(0.04)
+    img = make_frame("file:tsukuba_im3.png", FRAME_WIDTH, FRAME_HEIGHT)
+    k = K_CODE_DEFAULT
     c = hm.harris_stages(img, k, [0] * 16)["cornerness"]
     f = hm.harris_float(img, k / 256)
-    m = hm.interior_mask(288, 352, 3) & (f > 50 * 2 ** hm.CODE_SHIFT)
+    m = hm.interior_mask(FRAME_HEIGHT, FRAME_WIDTH, 3) & (f > 50 * 2 ** hm.CODE_SHIFT)
     ratio = c[m] * 2 ** hm.CODE_SHIFT / f[m]
     assert m.sum() > 100 and 0.9 < np.median(ratio) < 1.05
 
@@ -232,7 +234,7 @@ def _within1(a, b):
 @pytest.mark.parametrize("kf", [0.04, 0.06])
 @pytest.mark.parametrize("nms", [3, 5])
 def test_bit_true_and_float_find_the_same_corners(image, n_float, kf, nms):
-    img = make_frame(f"file:{image}", 352, 288)
+    img = make_frame(f"file:{image}", FRAME_WIDTH, FRAME_HEIGHT)
     k = hm.k_code(kf)
     f_all, mask = hm.float_features(img, k / 256, 0, nms=nms)
     c = hm.harris_float(img, k / 256)
@@ -268,7 +270,7 @@ def test_l_corners_are_all_detected_with_harris_inward_offset():
     # Isolated squares: every vertex is detected once, about one pixel inside the shape, in float64
     # as in the bit-true model (the offset is Harris's, not the quantization's).
     p = corner_pattern(seed=0, blur=0.5)
-    k = hm.k_code(0.04)
+    k = K_CODE_DEFAULT
     c = hm.harris_float(p.image, k / 256)
     thr = hm.threshold_code(0.05 * c.max())
     fixed, mask = hm.harris_mono(p.image, k, [thr] * 16, nms=3)
@@ -284,8 +286,8 @@ def test_cv2_corner_harris_third_opinion():
     # OpenCV's cornerHarris (box window, its own Sobel scaling) ranks corners somewhat differently;
     # as a sanity bound, most of its 100 strongest 3x3 local maxima on Tsukuba are among ours.
     # docs/benchmarks.md reports the full comparison.
-    img = make_frame("file:tsukuba_im3.png", 352, 288)
-    k = hm.k_code(0.04)
+    img = make_frame("file:tsukuba_im3.png", FRAME_WIDTH, FRAME_HEIGHT)
+    k = K_CODE_DEFAULT
     s = hm.harris_stages(img, k, [0] * 16, nms=3)
     mask = s["mask"]
     ours = np.where((s["flags"] > 0) & mask, s["cornerness"], -1)

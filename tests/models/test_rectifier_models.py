@@ -19,6 +19,7 @@ from eyestereo.tools.models import poly_unit as unit
 from eyestereo.tools.rectify import calibrations
 from eyestereo.tools.rectify.ffc import POLY_NAMES, FFCError, fixed_stages_codes, fixed_stages, float_eval
 from eyestereo.tools.reports.bench_ffc import synthetic_rig_polynomials
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 
 SMALL = "seed:3:2@40x20"
 
@@ -34,11 +35,11 @@ def rig_doc():
 
 
 def test_fixed_stages_codes_is_fixed_stages_with_the_codes(rig_doc):
-    polys = synthetic_rig_polynomials(352, 288)
+    polys = synthetic_rig_polynomials(FRAME_WIDTH, FRAME_HEIGHT)
     fm = rig_doc["_formats"]
     for n in POLY_NAMES:
-        a = fixed_stages(polys[n], fm, 352, 288)
-        b = fixed_stages_codes(rig_doc["polynomials"][n]["codes"], fm, 352, 288)
+        a = fixed_stages(polys[n], fm, FRAME_WIDTH, FRAME_HEIGHT)
+        b = fixed_stages_codes(rig_doc["polynomials"][n]["codes"], fm, FRAME_WIDTH, FRAME_HEIGHT)
         assert all(np.array_equal(np.asarray(a[q]), np.asarray(b[q])) for q in range(1, 27))
 
 
@@ -56,7 +57,7 @@ def test_default_calibration_is_the_synthetic_rig(rig_doc):
     assert (cal.width, cal.height, cal.source_width, cal.source_height) == (352, 288, 352, 288)
     assert unit.resolve_frac(cal) == cal.out_format.fl == 5  # coordinates ufix[14,5], as the thesis's
     assert unit.coord_format(5, 352) == ufix(14, 5)
-    polys = synthetic_rig_polynomials(352, 288)
+    polys = synthetic_rig_polynomials(FRAME_WIDTH, FRAME_HEIGHT)
     assert rig_doc["float_polynomials"] == polys
 
 
@@ -66,7 +67,7 @@ def test_model_follows_the_float_polynomials_within_the_ffc_bound(rig_doc):
     ev = unit.evaluate(cal)
     for n in POLY_NAMES:
         v = ev[n]["q24"] * 2.0 ** -cal.out_format.fl
-        ref = float_eval(rig_doc["float_polynomials"][n], 352, 288)
+        ref = float_eval(rig_doc["float_polynomials"][n], FRAME_WIDTH, FRAME_HEIGHT)
         assert np.mean((v - ref) ** 2) <= 0.01
         assert np.max(np.abs(v - ref)) < 0.25
 
@@ -117,7 +118,7 @@ def test_pairs_in_raster_order_with_stream_flags(small):
     ev = unit.evaluate(small, frac)
     w, h = small.width, small.height
     k = 0
-    for frame in range(2):
+    for _frame in range(2):
         for y in range(h):
             for x in range(w):
                 assert p["xl"][k] == ev["left_x"]["coord"][y, x] and p["yr"][k] == ev["right_y"]["coord"][y, x]

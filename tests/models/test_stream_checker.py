@@ -199,4 +199,5 @@ def test_docstring_timing_example():
     assert [(s.error, s.code) for s in steps] == [(False, 0)] * 4 + [(True, 2)] * 4
     assert m.output_beats(steps) == beats
     repaired = m.stream_checker(beats, 3, 2, repair=True)
-    assert repaired[4].out == (4, False, True) and m.output_beats(repaired) == beats[:4] + [(4, False, True)] + beats[5:]
+    assert repaired[4].out == (4, False, True)
+    assert m.output_beats(repaired) == beats[:4] + [(4, False, True)] + beats[5:]

@@ -18,7 +18,8 @@ from eyestereo.tools.rectify import calib as C
 from eyestereo.tools.rectify import maps as X
 from eyestereo.tools.rectify import rig as G
 
-DATA = Path(os.environ.get("EYESTEREO_SHARED", Path(__file__).resolve().parents[2].parent / "shared")) / "data" / "opencv_stereo_calib"
+SHARED = Path(os.environ.get("EYESTEREO_SHARED", Path(__file__).resolve().parents[2].parent / "shared"))
+DATA = SHARED / "data" / "opencv_stereo_calib"
 needs_data = pytest.mark.skipif(not DATA.is_dir(), reason=f"shared calibration images not found at {DATA}")
 
 
@@ -210,8 +211,8 @@ BAD_YAML = {
     "missing key": (lambda t: t.replace("rms: 0.5\n", ""), "key 'rms' is missing"),
     "garbage": (lambda t: "\x00\x01 this is : not [ yaml", "not an OpenCV YAML"),
     "bad D length": (lambda t: t.replace("D2: [ -0.1, 0.01, 0., 0. ]", "D2: [ -0.1, 0.01, 0. ]"), "D2 must have"),
-    "R not rotation": (lambda t: t.replace("[ 1., 0., 0., 0., 1., 0., 0., 0., 1. ]", "[ 2., 0., 0., 0., 1., 0., 0., 0., 1. ]"),
-                       "R is not a rotation"),
+    "R not rotation": (lambda t: t.replace("[ 1., 0., 0., 0., 1., 0., 0., 0., 1. ]",
+                                           "[ 2., 0., 0., 0., 1., 0., 0., 0., 1. ]"), "R is not a rotation"),
     "M text": (lambda t: t.replace("image_width: 640", "image_width: wide"), "image_width"),
     "M not camera": (lambda t: t.replace("500., 0., 320.", "-500., 0., 320."), "M1 is not a camera matrix"),
     "T wrong size": (lambda t: t.replace("[ -0.06, 0.001, 0.0 ]", "[ -0.06, 0.001 ]"), "'T' is a malformed matrix"),

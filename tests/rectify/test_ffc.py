@@ -571,7 +571,7 @@ def test_cli_ffc_writes_quantizers(tmp_path, capsys):
     doc = json.loads(out.read_text())
     assert doc["measure"] == "max" and doc["max_error"] == 0.02
     fm = [Fmt(q["signed"], q["wl"], q["fl"]) for q in doc["quantizers"]]
-    for n, p in RIG_SMALL.items():
+    for p in RIG_SMALL.values():
         assert np.max(np.abs(fixed_real(p, fm, SMALL_W, SMALL_H) - horner_float(p, SMALL_W, SMALL_H))) <= 0.02
     assert str(out) in stdout
 

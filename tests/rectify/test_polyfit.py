@@ -39,8 +39,8 @@ def test_term_order_is_the_thesis_order(degree):
 @pytest.mark.parametrize("degree", [2, 3, 4])
 def test_evaluate_matches_the_formula(degree):
     rng = np.random.default_rng(degree)
-    c = rng.normal(size=len(THESIS_TERMS[degree])) * np.array([1, 1e-2, 1e-2, 1e-4, 1e-4, 1e-4, 1e-6, 1e-6, 1e-6,
-                                                                1e-6, 1e-8, 1e-8, 1e-8, 1e-8, 1e-8])[:len(THESIS_TERMS[degree])]
+    scale = np.array([1, 1e-2, 1e-2, 1e-4, 1e-4, 1e-4, 1e-6, 1e-6, 1e-6, 1e-6, 1e-8, 1e-8, 1e-8, 1e-8, 1e-8])
+    c = rng.normal(size=len(THESIS_TERMS[degree])) * scale[:len(THESIS_TERMS[degree])]
     yy, xx = np.mgrid[0:31, 0:45].astype(float)
     assert np.allclose(P.evaluate(c, degree, 45, 31), by_hand(c, xx, yy), rtol=1e-13, atol=1e-12)
 
@@ -154,10 +154,12 @@ BAD_DOCS = {
     "float height": (lambda d: {**d, "height": 8.5}, "'height' must be a positive integer"),
     "degree 5": (lambda d: {**d, "degree": 5}, "'degree' must be 2, 3 or 4"),
     "wrong terms": (lambda d: {**d, "terms": THESIS_TERMS[2][::-1]}, "'terms' must be"),
-    "short poly": (lambda d: {**d, "polynomials": {**d["polynomials"], "left_y": [1.0]}}, "'left_y' must be a list of 6"),
+    "short poly": (lambda d: {**d, "polynomials": {**d["polynomials"], "left_y": [1.0]}},
+                   "'left_y' must be a list of 6"),
     "missing poly": (lambda d: {**d, "polynomials": {k: v for k, v in d["polynomials"].items() if k != "right_x"}},
                      "'right_x' must be a list"),
-    "string coeff": (lambda d: {**d, "polynomials": {**d["polynomials"], "left_x": ["1", 0, 0, 0, 0, 0]}}, "non-number"),
+    "string coeff": (lambda d: {**d, "polynomials": {**d["polynomials"], "left_x": ["1", 0, 0, 0, 0, 0]}},
+                     "non-number"),
     "bad report": (lambda d: {**d, "report": []}, "'report' must be an object"),
 }
 
@@ -230,7 +232,8 @@ def test_table_4_1_on_real_data_decreases_with_degree():
 
     from eyestereo.tools.rectify import calib as C
 
-    data = Path(os.environ.get("EYESTEREO_SHARED", Path(__file__).resolve().parents[2].parent / "shared")) / "data" / "opencv_stereo_calib"
+    shared = Path(os.environ.get("EYESTEREO_SHARED", Path(__file__).resolve().parents[2].parent / "shared"))
+    data = shared / "data" / "opencv_stereo_calib"
     if not data.is_dir():
         pytest.skip(f"shared calibration images not found at {data}")
     cal = C.calibrate_stereo(str(data / "left*.jpg"), str(data / "right*.jpg"))

@@ -23,7 +23,8 @@ from eyestereo.tools.cli import main as cli
 from eyestereo.tools.rectify import rig as G
 from eyestereo.tools.rectify.run import OUTPUT_FILES, PLOT_FILES, run_all
 
-DATA = Path(os.environ.get("EYESTEREO_SHARED", Path(__file__).resolve().parents[2].parent / "shared")) / "data" / "opencv_stereo_calib"
+SHARED = Path(os.environ.get("EYESTEREO_SHARED", Path(__file__).resolve().parents[2].parent / "shared"))
+DATA = SHARED / "data" / "opencv_stereo_calib"
 MAP_KEYS = ("left_x", "left_y", "right_x", "right_y")
 # thesis eq. 4.1: p1..p10 multiply 1, x, y, x^2, y^2, xy, x^3, y^3, x^2y, xy^2
 EXPONENTS = [(0, 0), (1, 0), (0, 1), (2, 0), (0, 2), (1, 1), (3, 0), (0, 3), (2, 1), (1, 2)]
@@ -61,7 +62,7 @@ def poly_by_hand(c: list[float], w: int, h: int) -> np.ndarray:
 def vhdl_codes(text: str) -> dict[str, list[int]]:
     """Coefficient codes from the package text: ``constant LEFT_X_P3 : q3_t := to_signed(-123, Q3_WL);``."""
     codes: dict[str, dict[int, int]] = {}
-    for name, i, kind, val, bkind, bits in re.findall(
+    for name, i, _kind, val, bkind, bits in re.findall(
             r"constant (LEFT_X|LEFT_Y|RIGHT_X|RIGHT_Y)_P(\d+) : q\d+_t := "
             r"(?:to_(signed|unsigned)\((-?\d+), Q\d+_WL\)|(signed|unsigned)'\(\"([01]+)\"\))", text):
         if bits:
@@ -182,7 +183,8 @@ def test_other_degrees_write_no_ffc_and_say_why(rig_run, tmp_path):
     for degree in (2, 4):
         out = tmp_path / f"d{degree}"
         res = run_all(calib, out, degree=degree, progress=False)
-        assert tree(out) == sorted(["maps.npz", "poly.json", "report.txt", "plots", *(f"plots/{p}" for p in PLOT_FILES)])
+        assert tree(out) == sorted(["maps.npz", "poly.json", "report.txt", "plots",
+                                    *(f"plots/{p}" for p in PLOT_FILES)])
         assert res["ffc"] is None
         assert json.loads((out / "poly.json").read_text())["degree"] == degree
         rep = (out / "report.txt").read_text()

@@ -17,7 +17,8 @@ from eyestereo.tools.rectify import warp as W
 from eyestereo.tools.rectify import maps as X
 from eyestereo.tools.rectify import rig as G
 
-DATA = Path(os.environ.get("EYESTEREO_SHARED", Path(__file__).resolve().parents[2].parent / "shared")) / "data" / "opencv_stereo_calib"
+SHARED = Path(os.environ.get("EYESTEREO_SHARED", Path(__file__).resolve().parents[2].parent / "shared"))
+DATA = SHARED / "data" / "opencv_stereo_calib"
 
 
 @pytest.fixture(scope="module")
@@ -170,7 +171,8 @@ def test_backward_and_forward_maps_are_inverse(rig_calib):
     maps = X.compute_maps(rig_calib)
     rng = np.random.default_rng(3)
     ys, xs = rng.integers(0, 288, 200), rng.integers(0, 352, 200)
-    for side, M, D, R in (("left", rig_calib.M1, rig_calib.D1, maps.R1), ("right", rig_calib.M2, rig_calib.D2, maps.R2)):
+    for side, M, D, R in (("left", rig_calib.M1, rig_calib.D1, maps.R1),
+                          ("right", rig_calib.M2, rig_calib.D2, maps.R2)):
         mx, my = maps.side(side)
         src = np.column_stack([mx[ys, xs], my[ys, xs]])
         back = X.rectify_points(src, M, D, R, maps.K)

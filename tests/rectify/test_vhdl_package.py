@@ -15,7 +15,6 @@ from pathlib import Path
 
 import pytest
 
-from eyestereo.tools.cli import ffc as cli_ffc
 from eyestereo.tools.cli import main as cli_main
 from eyestereo.tools.rectify import ffc, vhdl_package
 from eyestereo.tools.reports.bench_ffc import synthetic_rig_polynomials

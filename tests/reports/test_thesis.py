@@ -2,7 +2,6 @@
 
 import json
 
-import pytest
 
 from eyestereo.tools.reports.thesis import SECTIONS, main
 

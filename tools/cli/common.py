@@ -135,26 +135,11 @@ def positive(text: str) -> float:
     return v
 
 
-def count(text: str) -> int:
-    """A view count 1..99."""
-    try:
-        v = int(text)
-    except ValueError:
-        raise _type_error(f"not an integer: {text!r}") from None
-    if not 1 <= v <= 99:
-        raise _type_error(f"must be 1..99, got {v}")
-    return v
+#: A view count 1..99.
+count = integer(1, 99, "the view count")
 
-
-def nonneg_bits(text: str) -> int:
-    """An extra-precision bit count 0..62 (the FFC's L and H)."""
-    try:
-        v = int(text)
-    except ValueError:
-        raise _type_error(f"not an integer: {text!r}") from None
-    if not 0 <= v <= 62:
-        raise _type_error(f"must be 0..62, got {v}")
-    return v
+#: An extra-precision bit count 0..62 (the FFC's L and H).
+nonneg_bits = integer(0, 62, "the extra precision")
 
 
 def size(text: str) -> tuple[int, int]:

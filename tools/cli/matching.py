@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from eyestereo.tools.cli.common import EXIT_USAGE, number, positive, print_error, window
+from eyestereo.tools.constants import NMS_SIZES
 from eyestereo.tools.io import Outputs
 from eyestereo.tools.matching import metrics as Q
 from eyestereo.tools.matching import sparse as M
@@ -272,7 +273,7 @@ def _add_common(p: argparse.ArgumentParser) -> None:
                    help="threshold code instead of --corners (same for both images)")
     g.add_argument("--k", type=lambda t: number(t, float, 0, 255 / 256, "--k"), default=d["k"],
                    help=f"Harris k (default {d['k']})")
-    g.add_argument("--nms", type=int, choices=(1, 3, 5), default=d["nms"], help=f"NMS window (default {d['nms']})")
+    g.add_argument("--nms", type=int, choices=NMS_SIZES, default=d["nms"], help=f"NMS window (default {d['nms']})")
     g = p.add_argument_group("matching (defaults: NCC 11x11 >= 0.75, left-right check, disparities 0..width/4)")
     g.add_argument("--cost", choices=M.COSTS, default=d["cost"], help=f"cost function (default {d['cost']})")
     g.add_argument("--window", type=window, default=d["window"],

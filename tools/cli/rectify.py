@@ -294,7 +294,8 @@ def register(sub: Any) -> None:
                    help="mse: mean square difference fixed vs float; max: largest absolute difference")
     p.add_argument("--size", type=size, default=None,
                    help="rectified image size WxH (default: the calibrated size)")
-    p.add_argument("--method", choices=("thesis", "opencv"), default="thesis", help="maps construction (default thesis)")
+    p.add_argument("--method", choices=("thesis", "opencv"), default="thesis",
+                   help="maps construction (default thesis)")
     p.add_argument("--focal", choices=("mean", "min"), default="mean", help="common focal length (default mean)")
     p.add_argument("--low", type=nonneg_bits, default=0, help="FFC: lowest common extra precision L (default 0)")
     p.add_argument("--high", type=nonneg_bits, default=32, help="FFC: highest common extra precision H (default 32)")

@@ -36,6 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH, K_DEFAULT, NMS_DEFAULT, THRESHOLD_BLOCKS
 from eyestereo.tools.models import harris_mono as _hm
 from eyestereo.tools.models import prethreshold as _pre
 
@@ -46,7 +47,7 @@ __all__ = ["CODE_MAX", "IController", "LogController", "SecantController", "Hist
 CODE_MAX = (1 << 19) - 1
 
 
-def block_counts(flags, mask, blocks=(4, 4)) -> np.ndarray:
+def block_counts(flags, mask, blocks=THRESHOLD_BLOCKS) -> np.ndarray:
     """Corners per block (listed by block index by * BX + bx), counting only specified pixels."""
     f = np.asarray(flags).astype(bool)
     if mask is not None:
@@ -162,7 +163,8 @@ class History:
         return self.counts.sum(1)
 
 
-def run_sequence(frames, controller, *, k: float = 0.04, blocks=(4, 4), nms: int = 3) -> History:
+def run_sequence(frames, controller, *, k: float = K_DEFAULT, blocks=THRESHOLD_BLOCKS,
+                 nms: int = NMS_DEFAULT) -> History:
     """Process ``frames`` with the bit-true Harris model; frame t + 1 uses the codes from frame t's counts.
 
     Frame 0 uses the controller's initial codes (the hardware's are 0 after reset)."""
@@ -184,7 +186,7 @@ def run_sequence(frames, controller, *, k: float = 0.04, blocks=(4, 4), nms: int
     return History(np.array(codes), np.array(counts), np.asarray(controller.target, np.float64))
 
 
-def step_sequence(img, *, size=(352, 288), frames_per_step: int = 15,
+def step_sequence(img, *, size=(FRAME_WIDTH, FRAME_HEIGHT), frames_per_step: int = 15,
                   gains=(1.0, 0.5, 1.0, 1.6), pan: int = 1) -> tuple[list[np.ndarray], list[int]]:
     """(frames, step frame indices): a ``size`` crop panning ``pan`` px per frame (back and forth over
     the image) whose contrast about mid-grey changes by the factors in ``gains`` every

@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from eyestereo.tools.constants import K_DEFAULT, NMS_DEFAULT
 from eyestereo.tools.matching import metrics as Q
 from eyestereo.tools.matching import sparse as M
 
@@ -39,8 +40,8 @@ __all__ = ["DEFAULTS", "VARY", "default_d_max", "evaluate_pair", "match_params",
            "summary", "sweep_pair"]
 
 #: The matcher's defaults for a user (``eyestereo evaluate``); see the module docstring.
-DEFAULTS: dict[str, Any] = dict(corners=500, k=0.04, nms=3, cost="ncc", window=(11, 11), ncc_min=0.75, t_max=11.0,
-                                split=1, rows=0, lr_check=True, d_range=0.25)
+DEFAULTS: dict[str, Any] = dict(corners=500, k=K_DEFAULT, nms=NMS_DEFAULT, cost="ncc", window=(11, 11), ncc_min=0.75,
+                                t_max=11.0, split=1, rows=0, lr_check=True, d_range=0.25)
 
 #: Matching parameters ``sweep`` can vary.
 VARY = ("t_max", "window", "split", "cost", "rows", "ncc_min")

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from eyestereo.tools.constants import K_DEFAULT, NMS_DEFAULT, THRESHOLD_BLOCKS
 from eyestereo.tools.io import read_image, to_grey8
 from eyestereo.tools.models import harris_mono as _hm
 
@@ -139,7 +140,7 @@ def _flags_at(corner: np.ndarray, code, blocks, nms: int) -> np.ndarray:
     return _nms.nms(pre, nms)[0]
 
 
-def threshold_for_count(img, count: int, *, k: float = 0.04, nms: int = 3) -> int:
+def threshold_for_count(img, count: int, *, k: float = K_DEFAULT, nms: int = NMS_DEFAULT) -> int:
     """The one threshold code (all blocks) whose bit-true corner count is closest to ``count``.
 
     Bisection over the code (the count falls as the code rises, up to NMS plateau effects); ties go to
@@ -169,8 +170,8 @@ def threshold_for_count(img, count: int, *, k: float = 0.04, nms: int = 3) -> in
     return lo if abs(n(lo) - count) < abs(n(hi) - count) else hi
 
 
-def detect_corners(img, *, k: float = 0.04, threshold: int | None = None, count: int = 500,
-                   blocks=(4, 4), nms: int = 3) -> np.ndarray:
+def detect_corners(img, *, k: float = K_DEFAULT, threshold: int | None = None, count: int = 500,
+                   blocks=THRESHOLD_BLOCKS, nms: int = NMS_DEFAULT) -> np.ndarray:
     """Corners (x, y), shape (n, 2), by the bit-true Harris model :func:`harris_mono`.
 
     ``threshold``: a code (int, all blocks) or one code per block; None picks the single code whose
@@ -321,7 +322,7 @@ def match_features(left, right, left_xy, right_xy, *, window=(9, 9), t_max: floa
     ValueError on images of different sizes, empty or malformed feature lists, bad parameters.
     """
     left, right = check_pair(left, right)
-    hgt, wid = left.shape
+    wid = left.shape[1]
     fl = check_features(left_xy, left.shape, "left features")
     fr = check_features(right_xy, right.shape, "right features")
     if len(fl) == 0:

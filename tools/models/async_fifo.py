@@ -1,4 +1,4 @@
-"""Clock-accurate model of :func:`eyestereo.hdl.streaming.async_fifo.async_fifo`: which frames come out, which are dropped.
+"""Clock-accurate model of :func:`eyestereo.hdl.streaming.async_fifo.async_fifo`: the frames it passes and drops.
 
 The FIFO's behaviour depends on when words arrive, when the reader takes them and when each side sees the
 other's pointer through its two-flop synchroniser. The model knows both clocks (period and phase in ps),
@@ -62,11 +62,6 @@ class ClockSpec:
         if t < self.phase:
             return 0
         return (t - self.phase) // self.period + 1
-
-    def first_at_or_after(self, t: int) -> int:
-        if t <= self.phase:
-            return 0
-        return -((self.phase - t) // self.period)
 
     @property
     def mhz(self) -> float:
@@ -133,6 +128,17 @@ def _intervals(iv) -> list[tuple[int, int]]:
     return sorted(out)
 
 
+def _outside(e: int, intervals) -> int:
+    """The first edge >= e outside every ``(first, end)`` interval (they may touch or overlap)."""
+    moved = True
+    while moved:
+        moved = False
+        for a, b in intervals:
+            if a <= e < b:
+                e, moved = b, True
+    return e
+
+
 class _Reader:
     def __init__(self, rclk: ClockSpec, resets, stalls, r_sync: int):
         self.clk = rclk
@@ -145,16 +151,6 @@ class _Reader:
         self.last_eof = True
         self.last_edge = -1
 
-    def _outside(self, e: int, intervals) -> int:
-        """First edge >= e outside every interval."""
-        moved = True
-        while moved:
-            moved = False
-            for a, b in intervals:
-                if a <= e < b:
-                    e, moved = b, True
-        return e
-
     def push(self, entry: Entry, wclk: ClockSpec) -> None:
         a = self.clk.first_after(wclk.time(entry.wedge))
         p = max(a + self.r_sync, self.free)
@@ -163,7 +159,7 @@ class _Reader:
             while self.applied < len(self.resets) and self.resets[self.applied][0] <= p:
                 self.skip = not self.last_eof
                 self.applied += 1
-            q = self._outside(p, self.resets)
+            q = _outside(p, self.resets)
             if q == p:
                 break
             p = q
@@ -176,7 +172,7 @@ class _Reader:
             entry.leave, entry.taken = leave, False
             self.skip = not entry.eof
         else:
-            take = self._outside(p + 1, self.stalls)
+            take = _outside(p + 1, self.stalls)
             if nxt is not None and nxt <= take:
                 entry.leave, entry.taken = nxt, False
                 self.applied += 1
@@ -236,13 +232,7 @@ def async_fifo(beats, *, depth: int, wclk: ClockSpec, rclk: ClockSpec, wresets=(
         idx = len(entries) - depth
         if idx >= 0:
             k = max(k, vis[idx])
-        moved = True
-        while moved:
-            moved = False
-            for a, b in wres:
-                if a <= k < b:
-                    k, moved = b, True
-        return k
+        return _outside(k, wres)
 
     def reset_edge(k):
         if st["started"] and not st["bad"]:
@@ -289,30 +279,30 @@ def async_fifo(beats, *, depth: int, wclk: ClockSpec, rclk: ClockSpec, wresets=(
                 st["mid"] = False
             st["started"] = False
 
-    ri = 0
-    for b in beats:
-        data, eol, eof, k, tag = (b if isinstance(b, tuple) else (b.data, b.eol, b.eof, b.edge, b.frame))
-        # resets that begin before this beat (a pending token may be written before them)
-        while ri < len(wres) and wres[ri][0] <= k:
-            ra = wres[ri][0]
-            if st["tok"] and token_edge() < ra:
-                write(TOKEN_DATA, False, True, st["tok_tag"], token_edge())
-                st["tok"] = False
-            reset_edge(ra)
-            ri += 1
-        if in_wreset(k):
-            continue
-        beat(data, eol, eof, k, tag)
-    while ri < len(wres):
-        ra = wres[ri][0]
-        if st["tok"] and token_edge() < ra:
+    def write_token(before=float("inf")):
+        """The pending token, if any, written if it can be before edge ``before``."""
+        if st["tok"] and token_edge() < before:
             write(TOKEN_DATA, False, True, st["tok_tag"], token_edge())
             st["tok"] = False
-        reset_edge(ra)
-        ri += 1
-    if st["tok"]:
-        write(TOKEN_DATA, False, True, st["tok_tag"], token_edge())
-        st["tok"] = False
+
+    resets = iter(first for first, _ in wres)
+    ra = next(resets, None)
+
+    def resets_up_to(k):
+        """The resets that begin at or before edge ``k`` (a pending token may be written before each)."""
+        nonlocal ra
+        while ra is not None and ra <= k:
+            write_token(ra)
+            reset_edge(ra)
+            ra = next(resets, None)
+
+    for b in beats:
+        data, eol, eof, k, tag = (b if isinstance(b, tuple) else (b.data, b.eol, b.eof, b.edge, b.frame))
+        resets_up_to(k)
+        if not in_wreset(k):
+            beat(data, eol, eof, k, tag)
+    resets_up_to(float("inf"))
+    write_token()
     # the level seen by the writer, up to the last write
     if entries:
         full(entries[-1].wedge)

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from eyestereo.tools.camera import CameraTiming
+from eyestereo.tools.camera import DEFAULT_TIMING, CameraTiming
 from eyestereo.tools.models.async_fifo import ClockSpec, FifoResult, async_fifo
 from eyestereo.tools.models.camera_stream import camera_stream
 
@@ -42,7 +42,6 @@ class Result:
     dropped: int  # dropped-frame counter at the end
     last_edge: int  # read edge of the last beat (or discard), -1 if none
     fifo: FifoResult
-    camera_beats: int  # beats camera_stream produced (words and tokens)
 
     @property
     def outcome(self):
@@ -72,13 +71,13 @@ def _frames(res: FifoResult, width: int, height: int):
     return frames, ids, aborted, cut_off
 
 
-def camera_interface(runs, timing: CameraTiming = CameraTiming(), *, depth: int, pclk: ClockSpec,
+def camera_interface(runs, timing: CameraTiming = DEFAULT_TIMING, *, depth: int, pclk: ClockSpec,
                      rclk: ClockSpec, wresets=(), rresets=(), stalls=(), check: bool = True) -> Result:
     """What camera_interface delivers for a bus schedule.
 
     Args:
-        runs: the bus schedule (:func:`eyestereo.tools.camera.frame_schedule`, maybe :func:`~eyestereo.tools.camera.cut`);
-            sample j is on the bus at PCLK edge j.
+        runs: the bus schedule (:func:`eyestereo.tools.camera.frame_schedule`, maybe
+            :func:`~eyestereo.tools.camera.cut`); sample j is on the bus at PCLK edge j.
         timing: the camera timing the block is built for (geometry, order, polarities).
         depth: FIFO entries.
         pclk, rclk: camera and read clock (edge 0 = the first rising edge of each).
@@ -110,5 +109,4 @@ def camera_interface(runs, timing: CameraTiming = CameraTiming(), *, depth: int,
                     f"{alt[2]}, dropped {ref[3]} vs {alt[3]}")
     frames, ids, aborted, cut_off = _frames(res, timing.width, timing.height)
     return Result(beats=[(e.data, e.eol, e.eof, e.leave) for e in res.out], frames=frames, frame_ids=ids,
-                  aborted=aborted, cut_off=cut_off, dropped=res.dropped, last_edge=res.last_edge, fifo=res,
-                  camera_beats=len(beats))
+                  aborted=aborted, cut_off=cut_off, dropped=res.dropped, last_edge=res.last_edge, fifo=res)

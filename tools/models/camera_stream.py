@@ -12,8 +12,9 @@ nothing after their first sample):
   ``eol`` (and ``eof`` on the frame's last line; the frame is then complete and the block waits for the
   next VSYNC); any other length aborts the frame (line too short).
 * An aborted frame ends with a reset token (``eof`` without ``eol``; its data bits are unspecified, 0
-  here) if any of its words came out, and with nothing otherwise. A frame whose VSYNC the block did not see (it came out of reset, or the camera
-  was switched on, after it) is never started: no word of it comes out.
+  here) if any of its words came out, and with nothing otherwise. A frame whose VSYNC the block did not
+  see (it came out of reset, or the camera was switched on, after it) is never started: no word of it
+  comes out.
 * Reset (``rst`` high at an edge): the block forgets everything and waits for the next VSYNC.
 
 Sample ``j`` of the schedule is on the bus at PCLK edge ``j``; the block registers its inputs there, acts
@@ -27,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from eyestereo.tools.camera import WORD, CameraTiming, run_length
+from eyestereo.tools.camera import DEFAULT_TIMING, WORD, CameraTiming, run_length
 
 __all__ = ["Beat", "camera_stream", "frames_of", "OUT_DELAY", "WRITE_DELAY"]
 
@@ -60,7 +61,7 @@ def _in(intervals, e: int) -> bool:
     return any(a <= e < b for a, b in intervals)
 
 
-def camera_stream(runs, timing: CameraTiming = CameraTiming(), *, resets=()) -> list[Beat]:
+def camera_stream(runs, timing: CameraTiming = DEFAULT_TIMING, *, resets=()) -> list[Beat]:
     """Beats of camera_stream for a bus schedule (see :mod:`eyestereo.tools.camera`).
 
     ``resets``: ``[(first, end), ...]`` PCLK edge intervals in which ``rst`` is high (edges first..end-1).

@@ -30,8 +30,10 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from eyestereo.tools.packed import PackedWord
+
 __all__ = ["MAX_FRAC", "OFFSETS", "REUSE", "interpolate", "fetch_interpolate", "reads", "requests",
-           "stereo_stream", "weights"]
+           "side_word", "stereo_stream", "weights"]
 
 #: Largest ``frac`` the block accepts: weights of 2F+1 <= 17 bits keep both products in an 18x18
 #: multiplier (the Spartan-3E's MULT18X18).
@@ -63,6 +65,18 @@ def _reuse_table() -> dict[tuple[int, int], tuple[int, tuple[int, ...]]]:
 
 #: The reuse rule: (ddx, ddy) -> (request mask, source index in the kept neighbourhood per index).
 REUSE = _reuse_table()
+
+
+def side_word(frac: int) -> PackedWord:
+    """The block's side descriptor, queued between its requester and its interpolator (one per side of a
+    pair), least significant field first: the pair's ``eof``, ``eol``, the camera, out of range, the
+    request ``mask``, ``src`` (per index 0..3 the kept pixel's index, 2 bits each, index 0 lowest) and
+    the fractions ``dx``, ``dy`` (``max(frac, 1)`` bits: at least one bit, 0 for ``frac`` 0)."""
+    if not 0 <= frac <= MAX_FRAC:
+        raise ValueError(f"frac must be 0..{MAX_FRAC}, got {frac}")
+    fw = max(frac, 1)
+    return PackedWord("fetch side", [("eof", 1), ("eol", 1), ("cam", 1), ("oor", 1), ("mask", 4),
+                                     ("src", 2 * len(OFFSETS)), ("dx", fw), ("dy", fw)])
 
 
 def weights(dx: npt.ArrayLike, dy: npt.ArrayLike, frac: int) -> npt.NDArray[np.int64]:
@@ -163,4 +177,3 @@ def stereo_stream(left: npt.ArrayLike, right: npt.ArrayLike) -> dict[str, npt.ND
     eof = np.zeros((h, w), dtype=np.int64)
     eof[-1, -1] = 1
     return {"data": data, "cam": cam, "eol": np.repeat(eol.ravel(), 2), "eof": np.repeat(eof.ravel(), 2)}
-

@@ -14,6 +14,7 @@ import numbers
 
 import numpy as np
 
+from eyestereo.tools.constants import NMS_DEFAULT, NMS_SIZES, THRESHOLD_BLOCKS
 from eyestereo.tools.models import cornerness as _corner
 from eyestereo.tools.models import harris_window as _window
 from eyestereo.tools.models import nms as _nms
@@ -46,12 +47,12 @@ def radius(nms: int) -> int:
 
 
 def check_params(width: int, height: int, blocks: tuple[int, int], nms: int) -> None:
-    if isinstance(nms, bool) or not isinstance(nms, numbers.Integral) or nms not in (1, 3, 5):
-        raise ValueError(f"parameter nms must be 1, 3 or 5, got {nms!r}")
+    if isinstance(nms, bool) or not isinstance(nms, numbers.Integral) or nms not in NMS_SIZES:
+        raise ValueError(f"parameter nms must be {', '.join(map(str, NMS_SIZES[:-1]))} or {NMS_SIZES[-1]}, got {nms!r}")
     _pre.check_blocks(width, height, blocks)
 
 
-def harris_stages(frame: np.ndarray, k: int, thresholds, *, blocks=(4, 4), nms: int = 3) -> dict:
+def harris_stages(frame: np.ndarray, k: int, thresholds, *, blocks=THRESHOLD_BLOCKS, nms: int = NMS_DEFAULT) -> dict:
     """Every block's output for one 8-bit frame (integer codes)."""
     frame = np.asarray(frame, np.int64)
     h, w = frame.shape
@@ -65,7 +66,7 @@ def harris_stages(frame: np.ndarray, k: int, thresholds, *, blocks=(4, 4), nms: 
                 mask=interior_mask(h, w, radius(nms)))
 
 
-def harris_mono(frame: np.ndarray, k: int, thresholds, *, blocks=(4, 4), nms: int = 3):
+def harris_mono(frame: np.ndarray, k: int, thresholds, *, blocks=THRESHOLD_BLOCKS, nms: int = NMS_DEFAULT):
     """(feature flags, mask of specified pixels) as the hardware computes them."""
     s = harris_stages(frame, k, thresholds, blocks=blocks, nms=nms)
     return s["flags"], s["mask"]
@@ -105,7 +106,7 @@ def harris_float_terms(img: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def float_features(img: np.ndarray, k: float, threshold: float | np.ndarray, *, blocks=(1, 1),
-                   nms: int = 3) -> tuple[np.ndarray, np.ndarray]:
+                   nms: int = NMS_DEFAULT) -> tuple[np.ndarray, np.ndarray]:
     """(flags, mask): the float pipeline with the same pre-threshold and NMS rules as the hardware."""
     c = harris_float(img, k)
     thr = np.broadcast_to(np.asarray(threshold, np.float64), (blocks[0] * blocks[1],))

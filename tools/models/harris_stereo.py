@@ -13,18 +13,21 @@ import numbers
 
 import numpy as np
 
+from eyestereo.tools.constants import NMS_DEFAULT, SHARE_FACTORS, THRESHOLD_BLOCKS
 from eyestereo.tools.models import harris_mono as _mono
 
-SHARES = (1, 2, 3)
+#: The share factors (hdl.harris.harris_stereo imports them by this name).
 
 
 def check_share(share) -> int:
-    if isinstance(share, (bool, np.bool_)) or not isinstance(share, numbers.Integral) or int(share) not in SHARES:
-        raise ValueError(f"parameter share must be one of [1, 2, 3], got {type(share).__name__} {share!r}")
+    if (isinstance(share, (bool, np.bool_)) or not isinstance(share, numbers.Integral)
+            or int(share) not in SHARE_FACTORS):
+        raise ValueError(f"parameter share must be one of {list(SHARE_FACTORS)}, got {type(share).__name__} {share!r}")
     return int(share)
 
 
-def harris_stereo(left: np.ndarray, right: np.ndarray, k, thresholds, *, blocks=(4, 4), nms: int = 3):
+def harris_stereo(left: np.ndarray, right: np.ndarray, k, thresholds, *, blocks=THRESHOLD_BLOCKS,
+                  nms: int = NMS_DEFAULT):
     """(left flags, right flags, mask of specified pixels).
 
     ``k``: one k code for both cameras or a pair (left, right); ``thresholds``: one list of BX*BY codes

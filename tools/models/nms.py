@@ -4,12 +4,16 @@ A pixel is a feature when its value is > 0 and it beats every other pixel of the
 centred on it, where "beats" means: strictly greater than the neighbours that come before it in raster
 order (rows above; same row, to the left) and greater or equal to those after it. On a plateau of equal
 values that fits in the window, exactly one pixel survives: the plateau's first in raster order.
+
+The block takes mono and stereo streams; on a stereo stream each camera's flags are this function of
+that camera's frame (:func:`eyestereo.tools.models.harris_stereo.harris_stereo` applies it per camera).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from eyestereo.tools.constants import NMS_SIZES
 from eyestereo.tools.models.border import interior_mask
 from eyestereo.tools.packed import PackedWord
 
@@ -19,8 +23,8 @@ WORD = PackedWord("nms", [("corner", 1)])
 
 def nms(values: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
     """(feature flags 0/1, interior mask) for a frame of signed values."""
-    if size not in (1, 3, 5):
-        raise ValueError(f"nms size must be 1, 3 or 5, got {size}")
+    if size not in NMS_SIZES:
+        raise ValueError(f"nms size must be one of {NMS_SIZES}, got {size}")
     v = np.asarray(values, np.int64)
     h, w = v.shape
     r = size // 2

@@ -27,13 +27,14 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any
+from collections.abc import Sequence
 
 import numpy as np
 import numpy.typing as npt
 
 from eyestereo.tools.fixed import Fmt, ufix
-from eyestereo.tools.rectify.ffc import N_QUANTIZERS, POLY_NAMES, FFCError, fixed_stages_codes
+from eyestereo.tools.rectify.ffc import POLY_NAMES, FFCError, fixed_stages_codes
 
 __all__ = ["DEFAULT_FRAC", "LATENCY", "SELECT", "VALID", "Calibration", "coef_addr_bits", "coef_data_bits",
            "coord_bits", "coord_format", "cut", "evaluate", "int_bits", "poly_unit", "q24_codes", "range_limit",
@@ -53,7 +54,7 @@ VALID = 0b100
 MAX_FRAC = 16
 
 
-def resolve_frac(cal: "Calibration", frac: int | None = DEFAULT_FRAC) -> int:
+def resolve_frac(cal: Calibration, frac: int | None = DEFAULT_FRAC) -> int:
     """``frac``, or for ``None`` the default: q24's fraction length, clamped to 0..MAX_FRAC."""
     if frac is None:
         return min(max(cal.out_format.fl, 0), MAX_FRAC)
@@ -235,10 +236,3 @@ def poly_unit(cal: Calibration, x: npt.ArrayLike, y: npt.ArrayLike, select: npt.
         coord[m] = cut(q24, cal.out_format, frac, nb)
         oor[m] = (q24 < 0) | (q24 > lim)
     return coord, oor
-
-
-def check_formats(formats: Sequence[Fmt]) -> list[Fmt]:
-    fm = list(formats)
-    if len(fm) != N_QUANTIZERS or not all(isinstance(f, Fmt) for f in fm):
-        raise ValueError(f"need {N_QUANTIZERS} formats q1..q26")
-    return fm

@@ -1,4 +1,10 @@
-"""Bit-true model of :func:`eyestereo.hdl.harris.prethreshold.prethreshold` (thesis 6.2.4)."""
+"""Bit-true model of :func:`eyestereo.hdl.harris.prethreshold.prethreshold` (thesis 6.2.4).
+
+The block takes mono and stereo streams; on a stereo stream each camera has its own thresholds and its
+output is :func:`prethreshold` of that camera's frame with them (as
+:func:`eyestereo.tools.models.harris_stereo.harris_stereo` computes it). :func:`block_index` is also the
+model of :func:`eyestereo.hdl.harris.block_position.block_position`'s block output.
+"""
 
 from __future__ import annotations
 

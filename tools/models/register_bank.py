@@ -19,8 +19,9 @@ bits, and the bank keeps the bits its strobes and fields select.
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 from eyestereo.tools.regmap import OKAY, REGMAP, SLVERR, WRITABLE, RegisterMap, check_frame_size
 
 __all__ = ["RegisterBank", "strobe_mask"]
@@ -42,7 +43,7 @@ class RegisterBank:
     a bank that cannot be built.
     """
 
-    def __init__(self, regmap: RegisterMap = REGMAP, *, width: int = 352, height: int = 288):
+    def __init__(self, regmap: RegisterMap = REGMAP, *, width: int = FRAME_WIDTH, height: int = FRAME_HEIGHT):
         self.regmap = regmap
         width, height = check_frame_size(width, height)
         self.params = dict(width=width, height=height)

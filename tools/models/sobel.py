@@ -14,7 +14,6 @@ GRAD = sfix(11, 0)
 #: Output format of each component (thesis 6.2.1): the gradient floored to a multiple of 8.
 OUT = sfix(9, -3)
 OUT_BITS = OUT.wl
-OUT_FL = OUT.fl
 #: The stream word: Ix in bits 8..0, Iy in bits 17..9, two's complement codes of sfix[9,-3].
 WORD = PackedWord("sobel", [("ix", OUT), ("iy", OUT)])
 

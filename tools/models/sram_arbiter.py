@@ -14,24 +14,62 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 from eyestereo.tools.packed import PackedWord
 from eyestereo.tools.sram import DATA_BITS, WORDS, power_up_word
 
-__all__ = ["AddressMap", "CAMERA_WORD", "RECT_WORD", "MASTERS", "fetch_addresses", "DoubleBufferModel",
-           "Scoreboard", "STAT"]
+__all__ = ["AddressMap", "CAMERA_WORD", "RECT_WORD", "Master", "MASTER_TABLE", "MASTERS", "WRITERS",
+           "fetch_addresses", "DoubleBufferModel", "Scoreboard", "STAT"]
 
 #: A camera word: the pixel's Y in bits 7..0, its chroma sample (U for even x, V for odd x) in 15..8.
 CAMERA_WORD = PackedWord("camera", [("y", 8), ("c", 8)])
 #: A rectified word: the left image's pixel (x, y) in bits 7..0, the right image's in 15..8.
 RECT_WORD = PackedWord("rectified pair", [("left", 8), ("right", 8)])
 
+@dataclass(frozen=True)
+class Master:
+    """One master of the arbiter, described once: the arbiter generates its engine, its place in the round
+    robin and its status counters from this; the benches their agents and checks.
+
+    ``name``: its port on the arbiter (and its name in the counters and reports); ``engine``: ``"camera"``
+    (a camera's queue read port), ``"stereo"`` (the rectified stereo image stream), ``"features"`` (feature
+    lists on a queue read port) -- the three *writers*, each into its own double buffer named like the
+    master -- or ``"fetch"`` (the pixel fetch port's reads) or ``"host"`` (reads and writes);
+    ``urgent``: a writer of a stream that cannot wait (served before the round robin); ``burst``: the
+    arbiter parameter that sets its turn's length; ``read_tag``: the bits above the fetch index in the tag
+    of its reads (who gets the read data back).
+    """
+
+    name: str
+    engine: str
+    urgent: bool = False
+    burst: str = "burst"
+    read_tag: int = 0
+
+    @property
+    def writer(self) -> bool:
+        return self.engine in WRITER_ENGINES
+
+
+WRITER_ENGINES = ("camera", "stereo", "features")
+
 #: The arbiter's masters, in its order (the index of the counters and the round robin).
-MASTERS = ("cam0", "cam1", "fetch", "rect", "feat", "host")
+MASTER_TABLE = (
+    Master("cam0", "camera", urgent=True),
+    Master("cam1", "camera", urgent=True),
+    Master("fetch", "fetch", burst="fetch_burst"),
+    Master("rect", "stereo", urgent=True),
+    Master("feat", "features"),
+    Master("host", "host", burst="host_burst", read_tag=1),
+)
+MASTERS = tuple(m.name for m in MASTER_TABLE)
+#: The writers (and their double buffers), in the arbiter's order (the order of the buffer status words).
+WRITERS = tuple(m.name for m in MASTER_TABLE if m.writer)
 
 #: Register map of the arbiter's status port (word address -> meaning); 32-bit words.
 STAT = {
     **{i: f"words moved, {m}" for i, m in enumerate(MASTERS)},
-    **{6 + i: f"clocks waited, {m}" for i, m in enumerate(MASTERS)},
+    **{len(MASTERS) + i: f"clocks waited, {m}" for i, m in enumerate(MASTERS)},
     12: "clocks since reset",
     13: "camera 0 frames: dropped << 16 | published",
     14: "camera 1 frames: dropped << 16 | published",
@@ -44,7 +82,6 @@ STAT = {
     20: "feature list in buffer 0: overflowed << 31 | words",
     21: "feature list in buffer 1: overflowed << 31 | words",
 }
-BUFFER_STATES = ("FREE", "WRITING", "FULL", "READING")
 
 
 @dataclass(frozen=True)
@@ -62,8 +99,8 @@ class AddressMap:
     ======================  ============================  ===============================================
     """
 
-    width: int = 352
-    height: int = 288
+    width: int = FRAME_WIDTH
+    height: int = FRAME_HEIGHT
     feature_words: int = 8192
     words: int = WORDS
 
@@ -92,6 +129,21 @@ class AddressMap:
     def features(self, buf: int) -> int:
         self._check(0, buf)
         return 6 * self.frame + buf * self.feature_words
+
+    def bases(self, writer: str) -> tuple[int, int]:
+        """Base addresses of the two buffers of ``writer`` (a name of :data:`WRITERS`)."""
+        if writer in ("cam0", "cam1"):
+            return self.camera(int(writer[-1]), 0), self.camera(int(writer[-1]), 1)
+        if writer == "rect":
+            return self.rectified(0), self.rectified(1)
+        if writer == "feat":
+            return self.features(0), self.features(1)
+        raise ValueError(f"no buffers for {writer!r}: the writers are {WRITERS}")
+
+    def size(self, writer: str) -> int:
+        """Words of each buffer of ``writer``."""
+        self.bases(writer)
+        return self.feature_words if writer == "feat" else self.frame
 
     @property
     def host_base(self) -> int:
@@ -274,8 +326,7 @@ class BufferHistory:
     items in order (skipped items were dropped). Raises AssertionError with the first fault.
     """
 
-    def __init__(self, name: str, bases: tuple[int, int], size: int, writes, sent: list, *, stored=None,
-                 fixed_size: bool = True):
+    def __init__(self, name: str, bases: tuple[int, int], size: int, writes, sent: list, *, stored=None):
         self.name = name
         self.bases = bases
         self.size = size

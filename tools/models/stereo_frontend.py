@@ -1,4 +1,4 @@
-"""Bit-true model of :func:`eyestereo.hdl.system.stereo_frontend.stereo_frontend`: the numpy chain of the whole front end.
+"""Bit-true model of :func:`eyestereo.hdl.system.stereo_frontend.stereo_frontend`: the whole front end in numpy.
 
 camera words (what the camera models send) -> their Y (what the fetch port reads from the camera
 buffers) -> the rectification model (:mod:`eyestereo.tools.models.rectifier`) -> the stereo Harris
@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from eyestereo.tools.constants import NMS_DEFAULT, THRESHOLD_BLOCKS
 from eyestereo.tools.models import feature_list as fl_model
 from eyestereo.tools.models import harris_stereo as hs_model
 from eyestereo.tools.models import rectifier as rect_model
@@ -22,7 +23,7 @@ from eyestereo.tools.models.sram_arbiter import CAMERA_WORD, RECT_WORD
 __all__ = ["BLOCKS", "grey", "stereo_frontend", "rect_words", "list_words"]
 
 #: Threshold and count blocks per camera (the register map's 16 thresholds per camera).
-BLOCKS = (4, 4)
+BLOCKS = THRESHOLD_BLOCKS
 
 
 def grey(words) -> np.ndarray:
@@ -40,7 +41,7 @@ def list_words(words) -> list[int]:
     return [int(d) for d, _, _ in words]
 
 
-def stereo_frontend(cal: Calibration, left_words, right_words, k, thresholds, *, nms: int = 3,
+def stereo_frontend(cal: Calibration, left_words, right_words, k, thresholds, *, nms: int = NMS_DEFAULT,
                     border: int | None = None, max_features: int = 1023,
                     frac: int | None = DEFAULT_FRAC) -> dict:
     """One stereo frame through the whole chain.

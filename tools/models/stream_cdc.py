@@ -1,4 +1,4 @@
-"""Clock-accurate model of :func:`eyestereo.hdl.streaming.stream_cdc.stream_cdc`: the async FIFO's model on packed words.
+"""Clock-accurate model of :func:`eyestereo.hdl.streaming.stream_cdc.stream_cdc`: the FIFO's model on packed words.
 
 The block puts a stereo beat's ``cam``, ``eol`` and ``eof`` into the FIFO word and shows the FIFO
 ``eol``/``eof`` only on the right camera's beats and on reset tokens; the read side unpacks. So the

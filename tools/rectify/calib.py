@@ -508,8 +508,9 @@ def calibrate_stereo(left: str | Sequence[Any], right: str | Sequence[Any], *,
     ``log`` receives one line per skipped pair. Raises ValueError on unreadable or damaged images,
     mixed image sizes, unequal list lengths, identical left and right images, or fewer than 3 pairs
     with the board found in both images; with ``judge`` (default) the result is checked by
-    :func:`eyestereo.tools.rectify.judge.judge_calibration` (a :class:`~eyestereo.tools.rectify.judge.CalibrationProblem`
-    names the camera and the remedy) and ``info["notes"]`` holds its notes.
+    :func:`eyestereo.tools.rectify.judge.judge_calibration` (a
+    :class:`~eyestereo.tools.rectify.judge.CalibrationProblem` names the camera and the remedy) and
+    ``info["notes"]`` holds its notes.
     """
     lefts = expand_images(left, "left")
     rights = expand_images(right, "right")
@@ -537,7 +538,10 @@ def calibrate_stereo(left: str | Sequence[Any], right: str | Sequence[Any], *,
             ca, cb = find_corners(ga, board), find_corners(gb, board)
             bar.update()
             if ca is None or cb is None:
-                where = "either image" if ca is None and cb is None else ("the left image" if ca is None else "the right image")
+                if ca is None and cb is None:
+                    where = "either image"
+                else:
+                    where = "the left image" if ca is None else "the right image"
                 reason = f"{board[0]}x{board[1]} board not found in {where}"
                 skipped.append((na, nb, reason))
                 if log is not None:

@@ -216,7 +216,8 @@ def fit(maps: Maps, degree: int = 3, mask: np.ndarray | None = None) -> Fit:
     return result
 
 
-def table_4_1(maps: Maps, degrees: tuple[int, ...] = DEGREES, side: str = "both") -> dict[str, dict[str, dict[str, float]]]:
+def table_4_1(maps: Maps, degrees: tuple[int, ...] = DEGREES,
+              side: str = "both") -> dict[str, dict[str, dict[str, float]]]:
     """Table 4.1 for ``maps``: rows ``"none"`` and each degree, statistics of ``side``."""
     rows: dict[str, Any] = {}
     for d in degrees:

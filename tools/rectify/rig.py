@@ -57,23 +57,25 @@ PIXEL_M = 9e-6
 BASELINE_M = 0.066
 
 
-@dataclass(frozen=True)
-class StereoRig:
-    """True parameters of a stereo rig (same meaning as :class:`~eyestereo.tools.rectify.calib.StereoCalibration`)."""
+class StereoRig(StereoCalibration):
+    """True parameters of a stereo rig: a :class:`~eyestereo.tools.rectify.calib.StereoCalibration` (same
+    arrays, same meaning) with rms 0, built from the image size first; ``width``/``height`` name that size."""
 
-    width: int
-    height: int
-    M1: np.ndarray
-    D1: np.ndarray
-    M2: np.ndarray
-    D2: np.ndarray
-    R: np.ndarray
-    T: np.ndarray
+    def __init__(self, width: int, height: int, M1: np.ndarray, D1: np.ndarray, M2: np.ndarray,
+                 D2: np.ndarray, R: np.ndarray, T: np.ndarray) -> None:
+        super().__init__(M1, D1, M2, D2, R, T, width, height, 0.0)
+
+    @property
+    def width(self) -> int:
+        return self.image_width
+
+    @property
+    def height(self) -> int:
+        return self.image_height
 
     def calibration(self) -> StereoCalibration:
-        """The rig's truth as a calibration record (rms = 0)."""
-        return StereoCalibration(self.M1, self.D1, self.M2, self.D2, self.R, self.T, self.width,
-                                 self.height, 0.0)
+        """The rig's truth as a plain calibration record (rms = 0)."""
+        return StereoCalibration(self.M1, self.D1, self.M2, self.D2, self.R, self.T, self.width, self.height, 0.0)
 
 
 def eyebot_rig() -> StereoRig:
@@ -141,28 +143,45 @@ def _board_rotation(rng: np.random.Generator, tilt: float, spin: float) -> np.nd
     return cv2.Rodrigues(np.array([t[0], t[1], 0.0]))[0] @ cv2.Rodrigues(np.array([0.0, 0.0, s]))[0]
 
 
-def _sample_poses(rig: StereoRig, n: int, rng: np.random.Generator, board: tuple[int, int], square: float,
-                  margin_px: float = 6.0) -> list[tuple[np.ndarray, np.ndarray]]:
+def _draw_poses(n: int, max_tries: int, why: str, propose) -> list[tuple[np.ndarray, np.ndarray]]:
+    """``n`` poses from ``propose(i)`` (a pose for view ``i``, or None to draw again), a RuntimeError
+    ``why`` after ``max_tries`` draws."""
+    poses: list[tuple[np.ndarray, np.ndarray]] = []
+    for _ in range(max_tries):
+        if len(poses) == n:
+            break
+        pose = propose(len(poses))
+        if pose is not None:
+            poses.append(pose)
+    if len(poses) < n:
+        raise RuntimeError(why)
+    return poses
+
+
+def _aim(M: np.ndarray, px: np.ndarray, z: float, rb: np.ndarray, board: tuple[int, int],
+         square: float) -> np.ndarray:
+    """The translation that puts the centre of the board (rotated by ``rb``) at depth ``z`` on the ray of
+    pixel ``px`` of the camera with matrix ``M``."""
     cols, rows = board
     centre = np.array([(cols - 1) / 2 * square, (rows - 1) / 2 * square, 0.0])
+    return z * (np.linalg.inv(M) @ np.array([px[0], px[1], 1.0])) - rb @ centre
+
+
+def _sample_poses(rig: StereoRig, n: int, rng: np.random.Generator, board: tuple[int, int], square: float,
+                  margin_px: float = 6.0) -> list[tuple[np.ndarray, np.ndarray]]:
     outline = _paper_outline(board, square, 0.5 * square)
     w, h = rig.width, rig.height
-    poses: list[tuple[np.ndarray, np.ndarray]] = []
-    tries = 0
-    while len(poses) < n:
-        tries += 1
-        if tries > 20000:
-            raise RuntimeError("cannot place the board in view of both cameras")
+
+    def propose(_i):
         rb = _board_rotation(rng, 0.55, 0.35)  # tilted up to ~31 degrees, turned up to ~20 degrees
         z = rng.uniform(0.32, 0.55)
         # aim the board centre at a random pixel of the left image
         px = np.array([rng.uniform(0.2, 0.8) * w, rng.uniform(0.2, 0.8) * h])
-        ray = np.linalg.inv(rig.M1) @ np.array([px[0], px[1], 1.0])
-        tvec = z * ray - rb @ centre
+        tvec = _aim(rig.M1, px, z, rb, board, square)
         rvec = cv2.Rodrigues(rb)[0].ravel()
-        if _pose_ok(rig, rvec, tvec, outline, margin_px):
-            poses.append((rvec, tvec))
-    return poses
+        return (rvec, tvec) if _pose_ok(rig, rvec, tvec, outline, margin_px) else None
+
+    return _draw_poses(n, 20000, "cannot place the board in view of both cameras", propose)
 
 
 #: Targets of the "cover" layout, in this order: (camera 0 = left / 1 = right, x, y as fractions of
@@ -187,42 +206,37 @@ def _sample_cover_poses(rig: StereoRig, n: int, rng: np.random.Generator, board:
     turned by up to 20 degrees in the image plane; the paper wholly visible in both cameras; corners
     at least ``COVER_MIN_SPACING`` px apart."""
     cols, rows = board
-    centre = np.array([(cols - 1) / 2 * square, (rows - 1) / 2 * square, 0.0])
     outline = _paper_outline(board, square, (COVER_PAPER if paper is None else paper) * square)
     obj = board_object_points(board, square).astype(np.float64)
     w, h = rig.width, rig.height
-    poses: list[tuple[np.ndarray, np.ndarray]] = []
-    tries = 0
-    while len(poses) < n:
-        tries += 1
-        if tries > 200000:
-            raise RuntimeError("cannot place the board to cover the field of view of both cameras")
-        cam, fx, fy = COVER_TARGETS[len(poses) % len(COVER_TARGETS)]
+
+    def propose(i):
+        cam, fx, fy = COVER_TARGETS[i % len(COVER_TARGETS)]
         target = (fx * (w - 1), fy * (h - 1))
         rb = _board_rotation(rng, 0.6, 0.35)
         z = rng.uniform(0.32, COVER_FAR)
         half = 0.5 * cols * square * rig.M1[0, 0] / z  # half the board's width in pixels
         px = np.array([fx * w, fy * h]) + rng.uniform(-half, half, size=2)
         M = rig.M1 if cam == 0 else rig.M2
-        ray = np.linalg.inv(M) @ np.array([px[0], px[1], 1.0])
-        tvec = z * ray - rb @ centre
+        tvec = _aim(M, px, z, rb, board, square)
         if cam == 1:  # placed in the right camera's frame: X_left = R^T (X_right - T)
             rb, tvec = rig.R.T @ rb, rig.R.T @ (tvec - rig.T)
         rvec = cv2.Rodrigues(rb)[0].ravel()
         if not _pose_ok(rig, rvec, tvec, outline, margin_px):
-            continue
+            return None
         rv, tv = (rvec, tvec) if cam == 0 else _right_pose(rig, rvec, tvec)
         pts = _project(obj, rv, tv, M, rig.D1 if cam == 0 else rig.D2)
         hull = cv2.convexHull(pts.astype(np.float32))
         if cv2.pointPolygonTest(hull, (float(target[0]), float(target[1])), False) < 0:
-            continue
+            return None
         grid = pts.reshape(rows, cols, 2)
         spacing = min(np.linalg.norm(np.diff(grid, axis=0), axis=2).min(),
                       np.linalg.norm(np.diff(grid, axis=1), axis=2).min())
         if spacing < COVER_MIN_SPACING:  # too small to be found reliably
-            continue
-        poses.append((rvec, tvec))
-    return poses
+            return None
+        return rvec, tvec
+
+    return _draw_poses(n, 200000, "cannot place the board to cover the field of view of both cameras", propose)
 
 
 def _area_coverage(polys: list[np.ndarray], size: tuple[int, int]) -> np.ndarray:

@@ -99,7 +99,8 @@ def _report_text(info: dict[str, Any]) -> str:
         f"rectified images: {w}x{h} ({w * h} pixels), method {info['method']}, focal {info['focal']}: "
         f"f = {K[0, 0]:.3f} px, principal point ({K[0, 2]:.3f}, {K[1, 2]:.3f})",
         "",
-        f"Table 4.1, degree-{fit.degree} polynomials vs the maps over all {w * h} pixels (px; none = maps vs identity):",
+        f"Table 4.1, degree-{fit.degree} polynomials vs the maps over all {w * h} pixels "
+        "(px; none = maps vs identity):",
     ]
     for side in ("left", "right", "both"):
         lines += _table(fit.report, fit.degree, side)

@@ -3,8 +3,7 @@
 Runs :func:`eyestereo.tools.rectify.ffc.run_ffc` over every pixel of a 352x288 image (101,376 points, the
 four polynomials, coarse search + greedy tuning + merge) on realistic polynomials and writes the
 measured figures into the "Measured" section of the page given by ``--out`` (``make bench``:
-``docs/ffc.md``; between the ``bench:begin`` and ``bench:end`` markers; without ``--out`` they are only
-printed).
+``docs/ffc.md``; between the ``bench:begin`` and ``bench:end`` markers); they are printed in any case.
 
 The polynomials come from a synthetic stereo rig like the thesis's (EyeBot M6, 352x288, f ~ 544 px):
 radial distortion k1 = -0.3, k2 = 0.08 in normalized coordinates, a small rectifying rotation per
@@ -17,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import re
 import sys
 import time
 from pathlib import Path
@@ -25,42 +23,50 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
-from eyestereo.tools.io import atomic_write_text
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 from eyestereo.tools.rectify.ffc import POLY_NAMES, FFCResult, fixed_eval, float_eval, run_ffc
 from eyestereo.tools.rectify.synthetic_rig import fit_poly3, rig_maps, synthetic_rig_polynomials
 from eyestereo.tools.fixed import Fmt
+from eyestereo.tools.reports import publish
 
 __all__ = ["TABLE_A2", "fit_poly3", "main", "rig_maps", "synthetic_rig_polynomials"]
 
-#: Thesis Table A.2 (quantizer settings produced by the MATLAB Rectification Toolbox), columns
-#: X left, Y left, X right, Y right, merged; transcribed from the thesis.
-TABLE_A2: dict[str, list[str]] = {
-    "left_x": ["ufix[11,7]", "ufix[14,14]", "sfix[14,15]", "ufix[9,18]", "ufix[11,22]", "ufix[12,22]",
-               "sfix[13,30]", "ufix[7,31]", "sfix[1,25]", "sfix[13,30]", "ufix[5,21]", "sfix[13,22]",
-               "sfix[12,21]", "sfix[6,21]", "sfix[12,14]", "ufix[12,14]", "ufix[12,14]", "sfix[12,7]",
-               "ufix[14,5]", "sfix[11,21]", "ufix[12,21]", "sfix[13,15]", "ufix[13,13]", "ufix[14,5]",
-               "ufix[9,0]", "ufix[7,-2]"],
-    "left_y": ["ufix[7,6]", "sfix[13,15]", "ufix[14,14]", "ufix[11,22]", "ufix[12,22]", "ufix[12,21]",
-               "sfix[6,27]", "sfix[13,30]", "sfix[13,30]", "sfix[9,30]", "sfix[13,22]", "sfix[9,22]",
-               "sfix[9,22]", "sfix[13,22]", "ufix[11,14]", "ufix[13,14]", "sfix[13,15]", "ufix[14,5]",
-               "sfix[13,6]", "ufix[11,21]", "sfix[12,22]", "ufix[14,13]", "sfix[13,14]", "sfix[15,5]",
-               "ufix[9,0]", "ufix[9,0]"],
-    "right_x": ["ufix[9,6]", "ufix[12,12]", "sfix[13,15]", "ufix[13,22]", "ufix[11,21]", "ufix[12,22]",
-                "sfix[13,30]", "sfix[5,28]", "sfix[6,28]", "sfix[12,29]", "sfix[7,21]", "sfix[12,21]",
-                "sfix[13,22]", "sfix[8,22]", "sfix[12,14]", "ufix[13,15]", "ufix[12,14]", "sfix[11,6]",
-                "ufix[14,5]", "sfix[11,21]", "ufix[13,22]", "sfix[12,14]", "ufix[14,14]", "ufix[14,5]",
-                "ufix[9,0]", "ufix[9,0]"],
-    "right_y": ["ufix[6,7]", "sfix[14,15]", "ufix[13,13]", "ufix[10,21]", "ufix[9,18]", "ufix[11,20]",
-                "ufix[5,30]", "sfix[11,28]", "sfix[13,30]", "sfix[6,30]", "sfix[12,21]", "sfix[6,22]",
-                "ufix[5,22]", "sfix[13,22]", "ufix[11,14]", "ufix[13,14]", "sfix[14,15]", "ufix[14,5]",
-                "sfix[15,7]", "ufix[13,22]", "sfix[12,22]", "ufix[14,13]", "sfix[14,14]", "sfix[15,5]",
-                "ufix[8,-1]", "ufix[9,0]"],
-    "merged": ["ufix[11,7]", "sfix[16,15]", "sfix[16,15]", "ufix[13,22]", "ufix[13,22]", "ufix[13,22]",
-               "sfix[14,30]", "sfix[15,31]", "sfix[13,30]", "sfix[13,30]", "sfix[14,22]", "sfix[13,22]",
-               "sfix[14,22]", "sfix[13,22]", "sfix[13,14]", "ufix[14,15]", "sfix[15,15]", "sfix[17,7]",
-               "sfix[17,7]", "sfix[14,22]", "sfix[14,22]", "sfix[17,15]", "sfix[15,14]", "sfix[16,5]",
-               "ufix[9,0]", "ufix[9,0]"],
-}
+#: Thesis Table A.2 (quantizer settings produced by the MATLAB Rectification Toolbox), transcribed from
+#: the thesis: one row per quantizer q1..q26, columns X left, Y left, X right, Y right, merged.
+_TABLE_A2_TEXT = """\
+q   left_x       left_y       right_x      right_y      merged
+q1  ufix[11,7]   ufix[7,6]    ufix[9,6]    ufix[6,7]    ufix[11,7]
+q2  ufix[14,14]  sfix[13,15]  ufix[12,12]  sfix[14,15]  sfix[16,15]
+q3  sfix[14,15]  ufix[14,14]  sfix[13,15]  ufix[13,13]  sfix[16,15]
+q4  ufix[9,18]   ufix[11,22]  ufix[13,22]  ufix[10,21]  ufix[13,22]
+q5  ufix[11,22]  ufix[12,22]  ufix[11,21]  ufix[9,18]   ufix[13,22]
+q6  ufix[12,22]  ufix[12,21]  ufix[12,22]  ufix[11,20]  ufix[13,22]
+q7  sfix[13,30]  sfix[6,27]   sfix[13,30]  ufix[5,30]   sfix[14,30]
+q8  ufix[7,31]   sfix[13,30]  sfix[5,28]   sfix[11,28]  sfix[15,31]
+q9  sfix[1,25]   sfix[13,30]  sfix[6,28]   sfix[13,30]  sfix[13,30]
+q10 sfix[13,30]  sfix[9,30]   sfix[12,29]  sfix[6,30]   sfix[13,30]
+q11 ufix[5,21]   sfix[13,22]  sfix[7,21]   sfix[12,21]  sfix[14,22]
+q12 sfix[13,22]  sfix[9,22]   sfix[12,21]  sfix[6,22]   sfix[13,22]
+q13 sfix[12,21]  sfix[9,22]   sfix[13,22]  ufix[5,22]   sfix[14,22]
+q14 sfix[6,21]   sfix[13,22]  sfix[8,22]   sfix[13,22]  sfix[13,22]
+q15 sfix[12,14]  ufix[11,14]  sfix[12,14]  ufix[11,14]  sfix[13,14]
+q16 ufix[12,14]  ufix[13,14]  ufix[13,15]  ufix[13,14]  ufix[14,15]
+q17 ufix[12,14]  sfix[13,15]  ufix[12,14]  sfix[14,15]  sfix[15,15]
+q18 sfix[12,7]   ufix[14,5]   sfix[11,6]   ufix[14,5]   sfix[17,7]
+q19 ufix[14,5]   sfix[13,6]   ufix[14,5]   sfix[15,7]   sfix[17,7]
+q20 sfix[11,21]  ufix[11,21]  sfix[11,21]  ufix[13,22]  sfix[14,22]
+q21 ufix[12,21]  sfix[12,22]  ufix[13,22]  sfix[12,22]  sfix[14,22]
+q22 sfix[13,15]  ufix[14,13]  sfix[12,14]  ufix[14,13]  sfix[17,15]
+q23 ufix[13,13]  sfix[13,14]  ufix[14,14]  sfix[14,14]  sfix[15,14]
+q24 ufix[14,5]   sfix[15,5]   ufix[14,5]   sfix[15,5]   sfix[16,5]
+q25 ufix[9,0]    ufix[9,0]    ufix[9,0]    ufix[8,-1]   ufix[9,0]
+q26 ufix[7,-2]   ufix[9,0]    ufix[9,0]    ufix[9,0]    ufix[9,0]
+"""
+_TABLE_A2_HEAD, *_TABLE_A2_ROWS = (line.split() for line in _TABLE_A2_TEXT.splitlines())
+
+#: :data:`_TABLE_A2_TEXT` by column: ``TABLE_A2["merged"][i]`` is quantizer i + 1's merged format.
+TABLE_A2: dict[str, list[str]] = {name: [row[k] for row in _TABLE_A2_ROWS]
+                                  for k, name in enumerate(_TABLE_A2_HEAD) if name != "q"}
 
 
 def table_a2_formats(column: str) -> list[Fmt]:
@@ -78,7 +84,7 @@ def _dist_stats(ax: npt.NDArray[np.float64], ay: npt.NDArray[np.float64],
     return float(np.mean(d)), float(np.max(d))
 
 
-def run_bench(width: int = 352, height: int = 288, max_error: float = 0.01) -> tuple[str, FFCResult]:
+def run_bench(width: int = FRAME_WIDTH, height: int = FRAME_HEIGHT, max_error: float = 0.01) -> tuple[str, FFCResult]:
     maps = rig_maps(width, height)
     polys = {name: fit_poly3(maps[name]) for name in POLY_NAMES}
     ys, xs = np.mgrid[0:height, 0:width].astype(np.float64)
@@ -119,7 +125,7 @@ def run_bench(width: int = 352, height: int = 288, max_error: float = 0.01) -> t
         per = [("0" if r.zero[i] else str(r.formats[i])) for r in result.per_polynomial.values()]
         w(f"| q{i + 1} | " + " | ".join(per) + f" | {result.merged[i]} | {thesis[i]} |")
     total_thesis = sum(f.wl for f in thesis)
-    w(f"| **total bits** | " + " | ".join(str(sum(f.wl for f in r.formats)) for r in result.per_polynomial.values())
+    w("| **total bits** | " + " | ".join(str(sum(f.wl for f in r.formats)) for r in result.per_polynomial.values())
       + f" | **{result.total_bits}** | **{total_thesis}** |")
     w("")
     w(f"Merged total: {result.total_bits} bits here, {total_thesis} bits in Table A.2 "
@@ -160,29 +166,16 @@ def run_bench(width: int = 352, height: int = 288, max_error: float = 0.01) -> t
 BEGIN, END = "<!-- bench:begin -->", "<!-- bench:end -->"
 
 
-def write_section(doc: Path, text: str) -> None:
-    """Replace the text between the bench markers of ``doc`` (atomically)."""
-    old = doc.read_text(encoding="utf-8")
-    pattern = re.compile(re.escape(BEGIN) + r".*?" + re.escape(END), re.S)
-    if not pattern.search(old):
-        raise SystemExit(f"{doc}: no '{BEGIN}' ... '{END}' section to fill")
-    atomic_write_text(doc, pattern.sub(lambda _m: f"{BEGIN}\n{text}{END}", old))
-
-
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m eyestereo.tools.reports.bench_ffc", description=__doc__.split("\n")[0])
-    ap.add_argument("--width", type=int, default=352)
-    ap.add_argument("--height", type=int, default=288)
+    ap.add_argument("--width", type=int, default=FRAME_WIDTH)
+    ap.add_argument("--height", type=int, default=FRAME_HEIGHT)
     ap.add_argument("--max-error", type=float, default=0.01)
     ap.add_argument("--out", "--doc", dest="out", type=Path, default=None,
                     help="page whose bench section is replaced (e.g. docs/ffc.md); without it: print only")
     args = ap.parse_args(argv)
     text, _ = run_bench(args.width, args.height, args.max_error)
-    if args.out is None:
-        sys.stdout.write(text)
-    else:
-        write_section(args.out, text)
-        print(f"-> {args.out}")
+    publish(text, args.out, BEGIN, END)
     return 0
 
 

@@ -35,6 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
+from eyestereo.tools.constants import K_CODE_DEFAULT
 from eyestereo.tools.io import atomic_output, atomic_write_text
 from eyestereo.tools.matching import adaptive as A
 from eyestereo.tools.matching import dense as D
@@ -244,7 +245,7 @@ def study_split(sets, img: Path | None, write: bool) -> tuple[list[str], dict]:
         groups = {**{n: curves[n] for n in sets}, "all images (summed)": total}
         for k, (n, g) in enumerate(groups.items()):
             ax = fig.add_subplot(1, len(groups), k + 1)
-            for j, (c, _) in enumerate(SPLIT_CFGS):
+            for c, _ in SPLIT_CFGS:
                 if c in ("9 windows 3x3", "9 windows 7x7", "single 7x7"):
                     continue
                 ax.plot([r["bad"] for r in g[c]], [r["good"] for r in g[c]], ".-", ms=3, label=c)
@@ -426,7 +427,7 @@ def study_adaptive(sets, img: Path | None, write: bool) -> tuple[list[str], dict
     lines = []
     res = {}
     for n, (frames, steps) in seqs.items():
-        cap = np.array([A.block_counts(*hm.harris_mono(f, hm.k_code(0.04), [0] * 16)) for f in frames])
+        cap = np.array([A.block_counts(*hm.harris_mono(f, K_CODE_DEFAULT, [0] * 16)) for f in frames])
         for target in (10.0, 31.25):
             reach = np.minimum(cap, target)
             seg = list(zip([0] + steps, steps + [len(frames)]))
@@ -462,7 +463,7 @@ def study_adaptive(sets, img: Path | None, write: bool) -> tuple[list[str], dict
         for k, key in enumerate(keys):
             r = res[key]
             ax = fig.add_subplot(2, (len(keys) + 1) // 2, k + 1)
-            for c, err, _, h in r["rows"]:
+            for c, _err, _, h in r["rows"]:
                 if c in ("I, gain 0.25", "I, gain 2"):
                     continue
                 ax.plot(h.totals, label=c, lw=1.2 if "secant" in c else 0.9)

@@ -24,12 +24,13 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH, K_CODE_DEFAULT, NMS_DEFAULT
 from eyestereo.tools.io import atomic_write_text, read_image, to_grey8
 from eyestereo.tools.models import cornerness as cm
 from eyestereo.tools.models import harris_mono as hm
 from eyestereo.tools.testpattern import checkerboard_pattern, corner_pattern, match_corners
 
-W, H = 352, 288
+W, H = FRAME_WIDTH, FRAME_HEIGHT
 
 
 def load(path: Path) -> np.ndarray:
@@ -78,8 +79,8 @@ def opencv_opinion(images: dict[str, np.ndarray]) -> list[str]:
     rows = ["| image | cornerHarris blockSize | N strongest | ours near OpenCV's | OpenCV's near ours |",
             "|---|---:|---:|---:|---:|"]
     for name, img in images.items():
-        k = hm.k_code(0.04)
-        s = hm.harris_stages(img, k, [0] * 16, nms=3)
+        k = K_CODE_DEFAULT
+        s = hm.harris_stages(img, k, [0] * 16, nms=NMS_DEFAULT)
         ours = np.where((s["flags"] > 0) & s["mask"], s["cornerness"], -1)
         for bs in (3, 5):
             cv = cv2.cornerHarris(img.astype(np.float32), bs, 3, k / 256)

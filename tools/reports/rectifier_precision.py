@@ -37,9 +37,10 @@ import numpy.typing as npt
 
 from eyestereo.tools.models import poly_unit as unit
 from eyestereo.tools.rectify import calibrations
-from eyestereo.tools.io import atomic_write_text
+from eyestereo.tools.io import centre_crop
 from eyestereo.tools.rectify.ffc import POLY_NAMES, float_eval
 from eyestereo.tools.rectify.warp import imwarp
+from eyestereo.tools.reports import publish
 
 __all__ = ["FRACS", "choose_frac", "interpolate", "main", "study"]
 
@@ -66,10 +67,7 @@ def load_image(name: str, width: int, height: int) -> npt.NDArray[np.uint8]:
     img = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
     if img is None:
         raise FileNotFoundError(f"cannot read {path}")
-    if img.shape[0] < height or img.shape[1] < width:
-        raise ValueError(f"{path} is {img.shape[1]}x{img.shape[0]}, smaller than {width}x{height}")
-    y0, x0 = (img.shape[0] - height) // 2, (img.shape[1] - width) // 2
-    return img[y0:y0 + height, x0:x0 + width]
+    return centre_crop(img, width, height, str(path))
 
 
 def interpolate(img: npt.NDArray[np.uint8], xc: npt.NDArray[np.int64], yc: npt.NDArray[np.int64], frac: int,
@@ -178,14 +176,6 @@ def report(results: list[dict], labels: list[str], seconds: float) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_section(doc: Path, text: str) -> None:
-    old = doc.read_text(encoding="utf-8") if doc.exists() else ""
-    pattern = re.compile(re.escape(BEGIN) + r".*?" + re.escape(END), re.S)
-    if not pattern.search(old):
-        raise SystemExit(f"{doc}: no '{BEGIN}' ... '{END}' section to fill")
-    atomic_write_text(doc, pattern.sub(lambda _m: f"{BEGIN}\n{text}{END}", old))
-
-
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m eyestereo.tools.reports.rectifier_precision",
                                  description=__doc__.split("\n")[0])
@@ -200,11 +190,7 @@ def main(argv: list[str] | None = None) -> int:
             labels.append(label)
         except FileNotFoundError as exc:
             print(f"skipped {label}: {exc}", file=sys.stderr)
-    text = report(results, labels, time.perf_counter() - t0)
-    sys.stdout.write(text)
-    if not args.no_write:
-        write_section(args.doc, text)
-        print(f"written to {args.doc}")
+    publish(report(results, labels, time.perf_counter() - t0), None if args.no_write else args.doc, BEGIN, END)
     return 0
 
 

@@ -40,11 +40,12 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
 import eyestereo.tools
+from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH, K_CODE_DEFAULT, THRESHOLD_BLOCKS
 
 ROOT = Path(eyestereo.tools.__file__).resolve().parents[1]
 
@@ -133,7 +134,7 @@ def _rig_maps(ctx: Context):
         from eyestereo.tools.rectify.maps import ground_truth_maps
         from eyestereo.tools.rectify.rig import eyebot_rig
 
-        size = (176, 144) if ctx.quick else (352, 288)
+        size = (176, 144) if ctx.quick else (FRAME_WIDTH, FRAME_HEIGHT)
         ctx.cache["rig_maps"] = ground_truth_maps(eyebot_rig(), size=size)
     return ctx.cache["rig_maps"]
 
@@ -175,7 +176,7 @@ def section_regression(ctx: Context) -> list[str]:
     cv = None if ctx.quick else _opencv_maps(ctx.shared)
     if cv is not None:
         sets.append(("OpenCV sample pairs (640x480)", cv, _fits(ctx, "cv_fits", cv)))
-    for name, m, fs in sets:
+    for name, _, fs in sets:
         for side in ("left", "right"):
             rows.append([f"**{name}, {side}** none"] + _stat_row(fs[3].report["none"][side]))
             for d in (2, 3, 4):
@@ -436,27 +437,26 @@ def section_harris(ctx: Context) -> list[str]:
     from eyestereo.tools.models import harris_mono as hm
     from eyestereo.tools.models.prethreshold import block_index
 
-    w, h = (176, 144) if ctx.quick else (352, 288)
+    w, h = (176, 144) if ctx.quick else (FRAME_WIDTH, FRAME_HEIGHT)
     name = "chessboard_left01.jpg"
     img = _load_image(DATA / name, w, h)
-    k = hm.k_code(0.04)
-    corner = hm.harris_stages(img, k, [0], blocks=(1, 1), nms=1)["cornerness"]
+    corner = hm.harris_stages(img, K_CODE_DEFAULT, [0], blocks=(1, 1), nms=1)["cornerness"]
     target = 40 if ctx.quick else 160
     hi = int(corner.max()) + 1
     t_glob = _threshold_for(lambda t: int(_features_for(corner, [t], (1, 1), 5).sum()), target, 1, hi)
     # Per block: the same number of corners in each of the 16 blocks (two passes: NMS sees across borders).
-    bidx = block_index(h, w, (4, 4))
+    bidx = block_index(h, w, THRESHOLD_BLOCKS)
     thr = [t_glob] * 16
     for _ in range(2):
         for b in range(16):
             def count(t, b=b):
                 th = list(thr)
                 th[b] = t
-                return int((_features_for(corner, th, (4, 4), 5) & (bidx == b)).sum())
+                return int((_features_for(corner, th, THRESHOLD_BLOCKS, 5) & (bidx == b)).sum())
             thr[b] = _threshold_for(count, target // 16, 1, hi)
     cases = [("(a) global threshold, no NMS (Fig. 5.3)", [t_glob], (1, 1), 1),
              ("(b) global threshold, NMS 5x5 (Fig. 5.4 a)", [t_glob], (1, 1), 5),
-             ("(c) 4x4 block thresholds, NMS 5x5 (Fig. 5.4 b)", thr, (4, 4), 5)]
+             ("(c) 4x4 block thresholds, NMS 5x5 (Fig. 5.4 b)", thr, THRESHOLD_BLOCKS, 5)]
     fig = _figure(13, 4.4)
     rows = []
     for i, (title, th, blocks, nms) in enumerate(cases):
