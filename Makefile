@@ -108,8 +108,9 @@ lint: setup
 test-time: setup
 	$(PY) -m eyestereo.sim.measure.suite_time --out docs/suite.md --jobs $(JOBS)
 
-# SymbiYosys proofs (k-induction) and covers of the property sets in formal/, then their mutants, each of
-# which must be rejected (docs/formal.md); make test runs both too (about 30 s).
+# SymbiYosys proofs (k-induction, or bounded where stated) and covers of the property sets in formal/, then
+# their mutants, each of which must be rejected (docs/formal.md); make test runs the fast jobs (about 40 s),
+# the slow ones (tests/formal/test_formal.py's SLOW: register bank, sequencer, window filters, arbiter) only here.
 formal: setup
 	$(PY) formal/run.py
 	$(PY) formal/run.py --mutants

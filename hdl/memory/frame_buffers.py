@@ -9,9 +9,11 @@ the SRAM (the address map: :class:`eyestereo.tools.models.sram_arbiter.AddressMa
       +----------- aborted (token) ------+      a newer frame overwrites ----+      consumer releases --+
 
 * A producer starting a frame takes a buffer that is neither being written nor read: a FREE one if
-  there is one, else the older FULL one (the newest frame is kept for the consumer). With the other
-  buffer held by the consumer and this one still being written, there is none: the frame is dropped
-  (counted) and the producer's writer discards its words.
+  there is one, else the older FULL one (the newest frame is kept for the consumer). The block would
+  deny a start that finds no such buffer (the frame dropped, counted, its words discarded by the writer),
+  but with the arbiter's writers that cannot happen: a writer asks only while it holds no buffer, so one
+  of the two is always FREE or FULL (proven: formal/double_buffer_props.vh, docs/formal.md); a frame is
+  overwritten, never dropped, and ``dropped`` stays 0.
 * A frame becomes FULL when the writer has issued its last word to the SRAM controller; the controller
   is in order, so a consumer's read issued after that sees the whole frame. Nobody can read a
   half-written frame: the fetch port and the host address only buffers a consumer holds.

@@ -119,7 +119,10 @@ def window_control(clk, rst, sink, source, *, width: int, height: int, radius: i
 
     Mono streams: the tail comes one pixel per clock. Stereo streams: left and right in turn, one beat
     every ``share`` clocks, in clocks the sink leaves free of output, so that time-shared multipliers behind
-    it always see beats at least ``share`` clocks apart. ``share`` must be 1 for a mono stream.
+    it always see pixel beats at least ``share`` clocks apart. ``share`` must be 1 for a mono stream. A reset
+    token is forwarded after ``latency`` clocks whatever came before it, so with ``share`` > 1 it can leave
+    one clock after a tail beat (found by the formal proof, docs/formal.md): what that can disturb is the
+    tail beat's product, border data of a frame the token cuts, and a token's data are not used.
 
     ``lead_pixels`` (default ``r * width + r``): for a data path that decides pixel (x, y) later than at
     input (x + r, y + r), how many pixels of its camera the output runs behind the input (the stereo NMS's
