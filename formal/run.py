@@ -164,6 +164,34 @@ JOBS = {j.name: j for j in [
                   "x_last <= ($signed({1'b0, x}) == (3 - 1));", "x_last <= ($signed({1'b0, x}) == (3 - 2));"),
                  ("a missing eof not flagged (fault 3 becomes 0)", "fault = 3;", "fault = 0;"),
                  ("the code follows the latest fault, not the first", "if ((!err)) begin", "if (1'b1) begin"))),
+    Job("stream_checker_repair", "stream_checker", dict(width=4, height=3, data_width=2, repair=True),
+        "stream_checker_props.vh",
+        "repair on, any input: error/code as stream_checker's; the source always keeps the protocol (eol/eof "
+        "per beat count; every frame whole or cut short by a reset token)",
+        header="`define F_REPAIR\n", multiclock=False, mode="prove", depth=15, cover_depth=30,
+        mutants=(("the faulty beat leaves with its eol (not as a reset token)",
+                  "source_eol <= (sink_eol && (!faulty));", "source_eol <= sink_eol;"),)),
+    # the point operations (point_props.vh): flags delayed by the block's latency (docstring), free input;
+    # the frame size only checked by the blocks (the smallest, 1x1), the data widths fixed (57/20 bits)
+    Job("cornerness", "cornerness", dict(width=1, height=1), "point_props.vh",
+        "mono, any input: valid/eol/eof out = in 6 clocks before (none across rst), nothing out while idle",
+        header="localparam F_LAT = 6;\n", mode="prove", depth=8, cover_depth=12,
+        mutants=(("valid one clock short (5 stages)", "source_valid <= delay_rst0_dreg_rst4_q;",
+                  "source_valid <= delay_rst0_dreg_rst3_q;"),)),
+    Job("prethreshold", "prethreshold", dict(width=1, height=1, blocks=(1, 1)), "point_props.vh",
+        "mono, global threshold (blocks (1, 1)), any input and writes: valid/eol/eof out = in 1 clock before, "
+        "nothing out while idle, a pixel passes if greater than the threshold (signed), else 0",
+        header="localparam F_LAT = 1;\n`define F_THRESHOLD\n", mode="prove", depth=6, cover_depth=8,
+        mutants=(("greater or equal passes (>= for >)", "if ((global_threshold0_value > global_threshold0_thr))",
+                  "if ((global_threshold0_value >= global_threshold0_thr))"),)),
+    Job("prethreshold_blocks", "prethreshold", dict(width=2, height=2, blocks=(2, 2)), "point_props.vh",
+        "mono 2x2 frames in 2x2 blocks, protocol in: as prethreshold, each pixel against its own block's threshold "
+        "(the block position and the threshold table followed)",
+        header="localparam F_LAT = 1;\n`define F_THRESHOLD\n`define F_BLOCKS\n", mode="prove", depth=6,
+        cover_depth=10, mutant_depth=10,
+        mutants=(("the block row moves on by 1, not BX (a pixel of row 1 reads row 0's threshold)",
+                  "block_position0_base <= (block_position0_base + 2);",
+                  "block_position0_base <= (block_position0_base + 1);"),)),
     Job("stream_to_axis", "stream_to_axis", dict(width=3, height=2, data_width=2, depth=4), "stream_to_axis_props.vh",
         "protocol in, any tready: AXI4-Stream beats held until taken, TLAST every width-th beat, TUSER on "
         "a line's first beat and at most height lines a frame",

@@ -1,5 +1,6 @@
 // Formal properties of stream_checker (formal/run.py includes this file into MyHDL's Verilog of the block,
-// just before endmodule). Run mono, width=4, height=3 (4x3 frames), data_width=2, repair off. One clock.
+// just before endmodule). Run mono, width=4, height=3 (4x3 frames), data_width=2; repair off, or on with the
+// header `define F_REPAIR (then the stream is not passed unchanged but repaired: the section at F_REPAIR). One clock.
 // The input is free: any sequence of beats, idle cycles, reset tokens, lines and frames of any length.
 // A reference checker written from the block's specification (the fault table of its docstring) follows
 // the input from rst to its first fault; the properties say that the block agrees with it on every clock:
@@ -58,9 +59,53 @@ end
 always @(*) if (f_past) begin
     assert(error == f_seen);           // never a good frame flagged; every first fault flagged
     assert(code == f_code);            // with its code, kept until rst
+`ifndef F_REPAIR
     assert(source_valid == f_valid);   // the stream passes unchanged, one clock later
     if (source_valid) assert(source_eol == f_eol && source_eof == f_eof && source_data == f_data);
+`endif
 end
+
+`ifdef F_REPAIR
+// ---- repair on (header `define F_REPAIR): the source keeps the protocol, whatever the input ------------
+// The output's position in its frame (line_delay_props.vh's protocol model), asserted: eol exactly on a
+// line's width-th pixel, eof exactly on the frame's last; a reset token (the faulty beat) starts a frame.
+reg [1:0] f_ox = 2'd0, f_oy = 2'd0;
+wire f_opix = source_valid && (source_eol || !source_eof);
+wire f_otok = source_valid && source_eof && !source_eol;
+always @(posedge clk)
+    if (rst || f_otok) begin
+        f_ox <= 2'd0;
+        f_oy <= 2'd0;
+    end else if (f_opix) begin
+        f_ox <= (f_ox == F_W - 1) ? 2'd0 : f_ox + 2'd1;
+        if (f_ox == F_W - 1) f_oy <= (f_oy == F_H - 1) ? 2'd0 : f_oy + 2'd1;
+    end
+always @(*) if (f_past && f_opix) begin
+    assert(source_eol == (f_ox == F_W - 1));
+    assert(source_eof == (source_eol && f_oy == F_H - 1));
+    assert(source_data == f_data);     // a pixel that leaves is the input's, one clock later
+end
+// Invariants (they make the induction close): the output is where the checker was one clock before
+// while in sync, at a frame's start (after the token) while not.
+reg [1:0] f_xd = 2'd0, f_yd = 2'd0;
+reg f_syncd = 1'b1;
+always @(posedge clk) begin
+    f_xd <= x;
+    f_yd <= y;
+    f_syncd <= sync;
+end
+always @(*) if (f_past) begin
+    if (f_rst_p) assert(!source_valid && f_ox == 2'd0 && f_oy == 2'd0);
+    else if (f_syncd) assert(f_ox == f_xd && f_oy == f_yd);
+    else assert(f_ox == 2'd0 && f_oy == 2'd0);
+    assert(x < F_W && y < F_H && x_last == (x == F_W - 1) && y_last == (y == F_H - 1));
+    assert(f_ox < F_W && f_oy < F_H);
+end
+always @(*) if (f_past) begin
+    cover(f_otok && error);            // a broken frame cut short by a token
+    cover(f_opix && source_eof && error);  // a whole frame after a broken one
+end
+`endif
 
 // Invariants (they make the induction close): while no fault was seen, the block is in step with
 // the reference.
