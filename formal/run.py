@@ -268,14 +268,17 @@ JOBS = {j.name: j for j in [
                   "window_control0_tail <= 8;\n                    window_control0_half <= 1'b1;"))),
     Job("sobel_stereo_share2", "sobel", dict(width=3, height=3, stereo=True, share=2), "window_props.vh",
         "stereo 3x3 frames, input beats 2 clocks apart: as sobel_stereo, and the output's beats 2 clocks apart "
-        "(the tail's too)",
+        "(the tail's and reset tokens too; a token held at most 1 clock for it)",
         header=_window(3, 3, 4, 5, stereo=True, share=2), mode="prove", depth=23, cover_depth=64,
         mutant_depth=60,
         mutants=(("the tail's spacing not kept (wait not set by a tail beat)",
                   "window_control0_v0 <= 1'b1;\n                window_control0_c0 <= cam;\n"
                   "                window_control0_wait <= (2 - 1);",
                   "window_control0_v0 <= 1'b1;\n                window_control0_c0 <= cam;\n"
-                  "                window_control0_wait <= 0;"),)),
+                  "                window_control0_wait <= 0;"),
+                 ("a reset token not held for the spacing (forwarded one clock after a tail beat: the old form)",
+                  "if ((1'b1 && (window_control0_wait != 0))) begin",
+                  "if ((1'b0 && (window_control0_wait != 0))) begin"))),
     Job("nms", "nms", dict(width=3, height=3, size=3), "window_props.vh",
         "size 3, 3x3 frames: as sobel", header=_window(3, 3, 4, 5), mode="prove", depth=10, cover_depth=30,
         mutant_depth=20,

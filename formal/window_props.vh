@@ -106,23 +106,34 @@ always @(*) if (f_past && f_opix) begin
     assert(source_eol == (f_ox == F_W - 1));                // eol on (both beats of) the width-th pixel
     assert(source_eof == (source_eol && f_oy == F_H - 1));  // eof on (both beats of) the frame's last pixel
 end
-// a reset token comes out exactly F_D clocks after one went in (none else; rst clears both)
-reg [F_D:0] f_tok_in = 0;  // bit j: a token went in j clocks ago
+// a reset token comes out F_D clocks after one went in (share 1: exactly; share > 1: window_control may hold
+// it up to F_SHARE - 1 clocks for the spacing), exactly once, and no token else (rst clears both)
+localparam F_DT = F_D + F_SHARE - 1;  // the latest clock a token comes out
+reg [F_DT:0] f_tok_in = 0;  // bit j: a token went in j clocks ago
 always @(*) f_tok_in[0] = f_itok;
 always @(posedge clk)
-    if (rst) f_tok_in[F_D:1] <= 0;
-    else f_tok_in[F_D:1] <= f_tok_in[F_D - 1:0];
-always @(*) if (f_past) assert(f_otok == f_tok_in[F_D]);
-// stereo: the output's pixel beats come at least F_SHARE clocks after the beat before (the time-shared stage
-// behind relies on it). Not a reset token: with share 2, a token that comes in a clock after window_control
-// emitted a tail beat goes out in the next clock (found by this job's first form, which asserted it for
-// every beat: a reachable counterexample at step 43, see docs/formal.md)
+    if (rst) f_tok_in[F_DT:1] <= 0;
+    else f_tok_in[F_DT:1] <= f_tok_in[F_DT - 1:0];
+// tokens in come at least F_SHARE clocks apart, so the window [F_D, F_DT] holds at most one; f_tok_out: the
+// token of that window has come out
+reg f_tok_out = 1'b0;
+always @(posedge clk)
+    if (rst) f_tok_out <= 1'b0;
+    else if (f_tok_in[F_DT] || (f_tok_in[F_DT - 1 -: F_SHARE] == 0)) f_tok_out <= 1'b0;
+    else if (f_otok) f_tok_out <= 1'b1;
+always @(*) if (f_past) begin
+    if (f_otok) assert(f_tok_in[F_DT -: F_SHARE] != 0 && !f_tok_out);  // a token in its window, once
+    if (f_tok_in[F_DT]) assert(f_otok || f_tok_out);                  // ... and not later than F_DT
+end
+// stereo: every output beat, a reset token too, comes at least F_SHARE clocks after the beat before (the
+// time-shared stage behind relies on it; before window_control held tokens, a token that came in the clock
+// after a tail beat went out in the next clock: found by this job, see docs/formal.md)
 reg [7:0] f_ogap = 8'd255;
 always @(posedge clk)
     if (rst) f_ogap <= 8'd255;
     else if (source_valid) f_ogap <= 8'd1;
     else if (f_ogap != 8'd255) f_ogap <= f_ogap + 8'd1;
-always @(*) if (f_past && f_opix) assert(f_ogap >= F_SHARE);
+always @(*) if (f_past && source_valid) assert(f_ogap >= F_SHARE);
 // nothing comes out of an idle block beyond the tail: F_IDLE clocks after the last input beat, no output
 always @(*) if (f_past && f_igap != 8'd255 && f_igap > F_IDLE) assert(!source_valid);
 always @(*) if (f_past && f_igap == 8'd255) assert(!source_valid);
@@ -180,7 +191,9 @@ always @(*) if (f_past) begin
     end
     if (F_ST && f_tail == 0) assert(!f_half);
     if (F_ST && f_tail != 0) assert(f_half == ((F_N - f_tail) & 1));
-    assert({f_ocam, f_oy, f_ox} == f_qo);
+    // (share > 1: not while a token window_control held is on its way: the control's position is already
+    // reset, the output's is reset by the token)
+    if ((f_tok_in >> (F_D + 1)) == 0 || f_tok_out) assert({f_ocam, f_oy, f_ox} == f_qo);
     assert(f_pend == f_ones(f_end_d >> 1) + (f_tail != 0) + f_ones({f_wend_o[F_LAT - 2:0], f_wc_end}) + f_cut);
     if (f_cut) assert(f_tail == 0 && (f_tok_in >> (F_PRE + 1)) != 0);
 end

@@ -119,10 +119,12 @@ def window_control(clk, rst, sink, source, *, width: int, height: int, radius: i
 
     Mono streams: the tail comes one pixel per clock. Stereo streams: left and right in turn, one beat
     every ``share`` clocks, in clocks the sink leaves free of output, so that time-shared multipliers behind
-    it always see pixel beats at least ``share`` clocks apart. ``share`` must be 1 for a mono stream. A reset
-    token is forwarded after ``latency`` clocks whatever came before it, so with ``share`` > 1 it can leave
-    one clock after a tail beat (found by the formal proof, docs/formal.md): what that can disturb is the
-    tail beat's product, border data of a frame the token cuts, and a token's data are not used.
+    it always see beats at least ``share`` clocks apart. ``share`` must be 1 for a mono stream. A reset token
+    is forwarded after ``latency`` clocks, or, with ``share`` > 1 and a tail beat emitted in the last
+    ``share - 1`` clocks, held until ``share`` clocks after that beat (at most ``share - 1`` clocks more):
+    so tokens keep the spacing too (the formal proof found a token one clock after a tail beat before it
+    was held; docs/formal.md). Nothing else can be emitted while it is held: the token has cleared the
+    tail, and the sink's next beat comes ``share`` clocks after the token at the earliest.
 
     ``lead_pixels`` (default ``r * width + r``): for a data path that decides pixel (x, y) later than at
     input (x + r, y + r), how many pixels of its camera the output runs behind the input (the stereo NMS's
@@ -156,6 +158,9 @@ def window_control(clk, rst, sink, source, *, width: int, height: int, radius: i
         flags.append((c0, source.cam))
         wait = Signal(intbv(0, min=0, max=share))
         half = Signal(bool(0))  # camera of the next tail beat
+        # a reset token held until the spacing allows it (share > 1), and its camera
+        held, held_cam = Signal(bool(0)), Signal(bool(0))
+        hold_tokens = share > 1
 
         @always_seq(clk.posedge, reset=rst)
         def count():
@@ -173,10 +178,23 @@ def window_control(clk, rst, sink, source, *, width: int, height: int, radius: i
                 half.next = False
                 ox.next = 0
                 oy.next = 0
-                v0.next = True
-                f0.next = True
-                c0.next = sink.cam
-                wait.next = share - 1
+                if hold_tokens and wait != 0:
+                    # a beat left less than share clocks ago: the token waits for the spacing
+                    held.next = True
+                    held_cam.next = sink.cam
+                else:
+                    v0.next = True
+                    f0.next = True
+                    c0.next = sink.cam
+                    wait.next = share - 1
+                    held.next = False
+            elif hold_tokens and held:
+                if wait == 0:
+                    held.next = False
+                    v0.next = True
+                    f0.next = True
+                    c0.next = held_cam
+                    wait.next = share - 1
             else:
                 if sink.valid and skip == 0:
                     emit = True
