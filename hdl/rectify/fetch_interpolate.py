@@ -12,8 +12,11 @@ from eyestereo.hdl.interfaces.coord_pair import CoordPair
 from eyestereo.hdl.interfaces.fetch_port import check_fetch
 from eyestereo.tools.models import fetch_interpolate as model
 
-__all__ = ["DEFAULT_DEPTH", "fetch_interpolate"]
+__all__ = ["DEFAULT_DEPTH", "FIRST_PIXEL", "fetch_interpolate"]
 
+#: Clocks from the clock a pair is taken to its left pixel on ``source``, both sides in range and the
+#: memory answering at once (the timing diagram of :func:`fetch_interpolate`).
+FIRST_PIXEL = 11
 #: Default number of sides (requests or black pixels) in flight between the request and the output.
 DEFAULT_DEPTH = 4
 #: The 1-bit fields of the side word (:func:`eyestereo.tools.models.fetch_interpolate.side_word`), bool signals here.
@@ -59,20 +62,21 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
       the response FIFO (a fetched index) or from that camera's kept neighbourhood (a reused one);
       ``acc += w_i * p_i`` in the second. A step waits while its pixel has not arrived. A black side takes
       one step. The result ``(acc + S*S/2) >> 2*frac`` (round half up; exact bilinear interpolation
-      otherwise) goes out two clocks after the last step; the four pixels become that camera's kept
+      otherwise) goes out four clocks after the last step (five registered stages, one multiplier or adder
+      each: the weight, the product, the sum, the output); the four pixels become that camera's kept
       neighbourhood.
 
     Timing, one pair with both sides in range, the memory answering at once (``F`` a fetch beat, ``s``
     an interpolation step)::
 
-        cycle       0    1    2    3    4    5    6    7    8    9   10   11   12   13
-        coord.valid #    .    .    .    .    .    .    .    .    .    .    .    .    .
-        read_ack    #    _    _    .    .    .    .    .    .    .    .    .    .    .
-        req_valid   _    #L   #R   _    _    _    _    _    _    _    _    _    _    _
-        rsp_valid   _    _    F    F    F    F    _    _    _    _    _    _    _    _
-        steps (L)   _    _    _    _    s0   s1   s2   s3   _    _    _    _    _    _
-        steps (R)   _    _    _    _    _    _    _    _    s0   s1   s2   s3   _    _
-        source      _    _    _    _    _    _    _    _    _    L    _    _    _    R
+        cycle       0    1    2    3    4    5    6    7    8    9   10   11   12   13   14   15
+        coord.valid #    .    .    .    .    .    .    .    .    .    .    .    .    .    .    .
+        read_ack    #    _    _    .    .    .    .    .    .    .    .    .    .    .    .    .
+        req_valid   _    #L   #R   _    _    _    _    _    _    _    _    _    _    _    _    _
+        rsp_valid   _    _    F    F    F    F    _    _    _    _    _    _    _    _    _    _
+        steps (L)   _    _    _    _    s0   s1   s2   s3   _    _    _    _    _    _    _    _
+        steps (R)   _    _    _    _    _    _    _    _    s0   s1   s2   s3   _    _    _    _
+        source      _    _    _    _    _    _    _    _    _    _    _    L    _    _    _    R
 
     (with 2 pixels fetched per side; the steps of the next pairs follow without gaps while pairs come):
     8 clocks per stereo output pixel when both sides are in range, fewer for black sides.
@@ -94,8 +98,9 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
             answers a request 11 clocks later: 4 sides of 4 clocks hide it); the response FIFO has
             4 x ``depth`` entries.
 
-    Latency: a side's pixel leaves 2 clocks after its last step; with a memory answering at once the
-    first pixel of a frame comes 9 clocks after its pair is taken.
+    Latency: a side's pixel leaves 4 clocks after its last step; with a memory answering at once the
+    first pixel of a frame comes 11 clocks after its pair is taken (:data:`FIRST_PIXEL`; 9 before the
+    stages were split for the 110 MHz goal).
 
     Resources: 2 multipliers (the weight ``(F+1) x (F+1)`` bits, the weight times the pixel), two
     show-ahead FIFOs (queue ``depth`` x 18..32 bits, pixels 4 x ``depth`` x 8 bits, LUT-RAM), 8 kept
@@ -166,9 +171,19 @@ def requester(clk, rst, coord, fetch, side, push, queued, requesting, *, depth: 
     IDLE, LEFT, RIGHT = 0, 1, 2
     state = Signal(intbv(0, min=0, max=3))
     take, need, space = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
-    x0, tx = Signal(intbv(0)[ix:]), Signal(intbv(0)[ix:])
-    y0, ty = Signal(intbv(0)[iy:]), Signal(intbv(0)[iy:])
-    tv = Signal(bool(0))
+    x0, y0 = Signal(intbv(0)[ix:]), Signal(intbv(0)[iy:])
+    # per camera: the integer position of the pair on offer, its tag, the reuse rule's mask and sources on
+    # them (computed while the pair is offered and registered when it is taken, so that the request path
+    # starts at registers: the memory clock's goal, issue 23)
+    cx = [Signal(intbv(0)[ix:]) for _ in range(2)]
+    cy = [Signal(intbv(0)[iy:]) for _ in range(2)]
+    tx = [Signal(intbv(0)[ix:]) for _ in range(2)]
+    ty = [Signal(intbv(0)[iy:]) for _ in range(2)]
+    tv = [Signal(bool(0)) for _ in range(2)]
+    rmask = [Signal(intbv(0)[len(side.mask):]) for _ in range(2)]
+    rsrc = [Signal(intbv(0)[len(side.src):]) for _ in range(2)]
+    kmask = [Signal(intbv(0)[len(side.mask):]) for _ in range(2)]
+    ksrc = [Signal(intbv(0)[len(side.src):]) for _ in range(2)]
 
     @always_comb
     def control():
@@ -203,8 +218,32 @@ def requester(clk, rst, coord, fetch, side, push, queued, requesting, *, depth: 
             else:
                 state.next = IDLE
 
-    return (control, request, states, pair_side(clk, rst, coord, take, side, x0, y0),
-            tags(clk, rst, push, side, x0, y0, tx, ty, tv), reuse_rule(x0, y0, tx, ty, tv, side))
+    @always_comb
+    def offered():
+        cx[0].next = coord.xl[len(coord.xl):frac]
+        cy[0].next = coord.yl[len(coord.yl):frac]
+        cx[1].next = coord.xr[len(coord.xr):frac]
+        cy[1].next = coord.yr[len(coord.yr):frac]
+
+    @always_seq(clk.posedge, reset=rst)
+    def rule_taken():
+        if take:
+            for c in range(2):
+                kmask[c].next = rmask[c]
+                ksrc[c].next = rsrc[c]
+
+    @always_comb
+    def rule_of_side():
+        if side.cam:
+            side.mask.next = kmask[1]
+            side.src.next = ksrc[1]
+        else:
+            side.mask.next = kmask[0]
+            side.src.next = ksrc[0]
+
+    return (control, request, states, offered, rule_taken, rule_of_side,
+            pair_side(clk, rst, coord, take, side, x0, y0), tags(clk, rst, push, side, x0, y0, tx, ty, tv),
+            [reuse_rule(cx[c], cy[c], tx[c], ty[c], tv[c], rmask[c], rsrc[c]) for c in range(2)])
 
 
 @block
@@ -257,48 +296,36 @@ def pair_side(clk, rst, coord, take, side, x0, y0):
 
 @block
 def tags(clk, rst, push, side, x0, y0, tx, ty, tv):
-    """Per camera the tag of its kept neighbourhood (the position of its last in-range side, valid bit
-    ``tv``), ``side.cam``'s on ``tx``, ``ty``, ``tv``; emptied after a pair with ``eof`` (the frame
-    buffers change)."""
-    txl, txr = Signal(intbv(0)[len(x0):]), Signal(intbv(0)[len(x0):])
-    tyl, tyr = Signal(intbv(0)[len(y0):]), Signal(intbv(0)[len(y0):])
-    tvl, tvr = Signal(bool(0)), Signal(bool(0))
+    """Per camera c the tag of its kept neighbourhood: ``tx[c]``, ``ty[c]``, the position of its last
+    in-range side, valid if ``tv[c]``; emptied after a pair with ``eof`` (the frame buffers change).
 
-    @always_comb
-    def select():
-        if side.cam:
-            tx.next = txr
-            ty.next = tyr
-            tv.next = tvr
-        else:
-            tx.next = txl
-            ty.next = tyl
-            tv.next = tvl
+    A side's tag is up to date when the next pair is taken: the left tag changes with the left side's
+    push, the right one with the right side's, and a pair is taken only after both."""
 
     @always_seq(clk.posedge, reset=rst)
     def update():
         if push:
             if not side.cam:
                 if not side.oor:
-                    txl.next = x0
-                    tyl.next = y0
-                    tvl.next = 1
+                    tx[0].next = x0
+                    ty[0].next = y0
+                    tv[0].next = 1
             else:
                 if not side.oor:
-                    txr.next = x0
-                    tyr.next = y0
-                    tvr.next = 1
+                    tx[1].next = x0
+                    ty[1].next = y0
+                    tv[1].next = 1
                 if side.eof:
-                    tvl.next = 0
-                    tvr.next = 0
+                    tv[0].next = 0
+                    tv[1].next = 0
 
-    return select, update
+    return update
 
 
 @block
-def reuse_rule(x0, y0, tx, ty, tv, side):
-    """The reuse rule (:func:`_tables`): from the side's position and its camera's tag, the request
-    ``side.mask`` and where each kept pixel comes from, ``side.src``."""
+def reuse_rule(x0, y0, tx, ty, tv, mask, src):
+    """The reuse rule (:func:`_tables`): from a side's position and its camera's tag, the request ``mask``
+    and where each kept pixel comes from, ``src``."""
     ix, iy = len(x0), len(y0)
     MASK_T, SRC_T = _tables()
     XOFF, YOFF = (1 << (ix + 1)) + 1, (1 << (iy + 1)) + 1
@@ -341,11 +368,11 @@ def reuse_rule(x0, y0, tx, ty, tv, side):
 
     @always_comb
     def mask_rom():
-        side.mask.next = MASK_T[code]
+        mask.next = MASK_T[code]
 
     @always_comb
     def src_rom():
-        side.src.next = SRC_T[code]
+        src.next = SRC_T[code]
 
     return offsets, offsets_low, steps, table_index, mask_rom, src_rom
 
@@ -361,7 +388,7 @@ def interpolator(clk, rst, head, queued, pixel, held, pop, rpop, source, running
     fetched = Signal(bool(0))  # the step's pixel comes from the response FIFO
     fire, last = Signal(bool(0)), Signal(bool(0))
     pix, kpix = Signal(intbv(0)[8:]), Signal(intbv(0)[8:])
-    weight = Signal(intbv(0)[2 * frac + 2:])
+    wa, wb = Signal(intbv(0)[frac + 1:]), Signal(intbv(0)[frac + 1:])
 
     @always_comb
     def step_fire():
@@ -380,8 +407,8 @@ def interpolator(clk, rst, head, queued, pixel, held, pop, rpop, source, running
             else:
                 step.next = step + 1
 
-    return (step_fire, steps, kept_pixels(clk, fire, head, step, pix, kpix), step_weight(step, head, weight, frac=frac),
-            mac(clk, rst, fire, last, step, head, weight, pix, source, running, frac=frac))
+    return (step_fire, steps, kept_pixels(clk, fire, head, step, pix, kpix), step_weight(step, head, wa, wb, frac=frac),
+            mac(clk, rst, fire, last, step, head, wa, wb, pix, source, running, frac=frac))
 
 
 @block
@@ -434,11 +461,10 @@ def kept_pixels(clk, fire, head, step, pix, kpix):
 
 
 @block
-def step_weight(step, head, weight, *, frac: int):
-    """The step's weight: index 0 ``dx*dy``, 1 ``(S-dx)*dy``, 2 ``dx*(S-dy)``, 3 ``(S-dx)*(S-dy)``
-    (S = 2**frac), the first multiplier."""
+def step_weight(step, head, wa, wb, *, frac: int):
+    """The step's weight factors ``wa``, ``wb`` (their product, in :func:`mac`, is the weight): index 0
+    ``dx*dy``, 1 ``(S-dx)*dy``, 2 ``dx*(S-dy)``, 3 ``(S-dx)*(S-dy)`` (S = 2**frac)."""
     S = 1 << frac
-    wa, wb = Signal(intbv(0)[frac + 1:]), Signal(intbv(0)[frac + 1:])
 
     @always_comb
     def factors():
@@ -451,22 +477,24 @@ def step_weight(step, head, weight, *, frac: int):
         else:
             wb.next = S - head.dy
 
-    @always_comb
-    def multiply():
-        weight.next = wa * wb
-
-    return factors, multiply
+    return factors
 
 
 @block
-def mac(clk, rst, fire, last, step, head, weight, pix, source, running, *, frac: int):
-    """Stage 1 registers the step's weight and pixel (0 for a black side), stage 2 accumulates
-    ``acc += w * p`` (the second multiplier; restarting at index 0), the output register takes
+def mac(clk, rst, fire, last, step, head, wa, wb, pix, source, running, *, frac: int):
+    """Five registered stages, one multiplier or adder each, so that no path runs through a multiplier
+    and more (the memory clock's goal, issue 23): 1 registers the step's weight factors and pixel (0 for
+    a black side), 2 the weight ``wa * wb`` (the first multiplier), 3 the product ``w * p`` (the second),
+    4 accumulates (``acc = w * p`` at index 0, ``acc + w * p`` after), the output register takes
     ``(acc + S*S/2) >> 2*frac`` after a side's last step; ``running`` while a step is in the stages."""
-    v1, first1, last1, v2 = Signal(bool(0)), Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
-    w1 = Signal(intbv(0)[2 * frac + 2:])
-    p1 = Signal(intbv(0)[8:])
-    t1, t2 = Signal(intbv(0)[3:]), Signal(intbv(0)[3:])  # cam, eol, eof
+    v1, v2, v3, v4 = (Signal(bool(0)) for _ in range(4))
+    first1, first2, first3 = (Signal(bool(0)) for _ in range(3))
+    last1, last2, last3 = (Signal(bool(0)) for _ in range(3))
+    wa1, wb1 = Signal(intbv(0)[frac + 1:]), Signal(intbv(0)[frac + 1:])
+    w2 = Signal(intbv(0)[2 * frac + 2:])
+    p1, p2 = Signal(intbv(0)[8:]), Signal(intbv(0)[8:])
+    m3 = Signal(intbv(0)[2 * frac + 10:])
+    t1, t2, t3, t4 = (Signal(intbv(0)[3:]) for _ in range(4))  # cam, eol, eof
     ACC = 8 + 2 * frac + 1
     acc = Signal(intbv(0)[ACC:])
     rounded = Signal(intbv(0)[ACC + 1:])
@@ -480,24 +508,36 @@ def mac(clk, rst, fire, last, step, head, weight, pix, source, running, *, frac:
             last1.next = last
             t1.next = concat(head.cam, head.eol, head.eof)
             if head.oor:
-                w1.next = 0
+                wa1.next = 0
                 p1.next = 0
             else:
-                w1.next = weight
+                wa1.next = wa
                 p1.next = pix
-        v2.next = v1 and last1
-        if v1:
-            t2.next = t1
-            if first1:
-                acc.next = w1 * p1
+            wb1.next = wb
+        v2.next = v1
+        first2.next = first1
+        last2.next = last1
+        t2.next = t1
+        w2.next = wa1 * wb1
+        p2.next = p1
+        v3.next = v2
+        first3.next = first2
+        last3.next = last2
+        t3.next = t2
+        m3.next = w2 * p2
+        v4.next = v3 and last3
+        if v3:
+            t4.next = t3
+            if first3:
+                acc.next = m3
             else:
-                acc.next = acc + w1 * p1
-        source.valid.next = v2
-        if v2:
+                acc.next = acc + m3
+        source.valid.next = v4
+        if v4:
             source.data.next = rounded[ACC:2 * frac]
-            source.cam.next = t2[2]
-            source.eol.next = t2[1]
-            source.eof.next = t2[0]
+            source.cam.next = t4[2]
+            source.eol.next = t4[1]
+            source.eof.next = t4[0]
 
     @always_comb
     def rounding():
@@ -505,6 +545,6 @@ def mac(clk, rst, fire, last, step, head, weight, pix, source, running, *, frac:
 
     @always_comb
     def running_out():
-        running.next = v1 or v2
+        running.next = v1 or v2 or v3 or v4
 
     return stages, rounding, running_out

@@ -11,6 +11,7 @@ from eyestereo.hdl.interfaces.fetch_port import check_fetch
 from eyestereo.hdl.rectify.calibration import calibration_param
 from eyestereo.hdl.rectify.coordinate_warper import FIRST_PAIR, coordinate_warper
 from eyestereo.hdl.rectify.fetch_interpolate import DEFAULT_DEPTH, fetch_interpolate
+from eyestereo.hdl.rectify.fetch_interpolate import FIRST_PIXEL as FETCH_FIRST_PIXEL
 from eyestereo.tools.models import fetch_interpolate as fi_model
 from eyestereo.tools.models import poly_unit as unit_model
 
@@ -18,7 +19,7 @@ __all__ = ["FIRST_PIXEL", "rectifier"]
 
 #: Clocks from the ``start`` clock to the first output beat with a memory answering at once (both sides
 #: of the first pixel in range): the warper's first pair, then the fetch and the interpolation.
-FIRST_PIXEL = FIRST_PAIR + 9
+FIRST_PIXEL = FIRST_PAIR + FETCH_FIRST_PIXEL
 
 
 @block
@@ -60,7 +61,7 @@ def rectifier(clk, rst, start, fetch, source, busy, coef=None, *, quantizers=Non
             coordinates' fraction bits (default q24's, at most 8 here), as for the warper.
         depth: sides in flight in the fetch/interpolate unit (1..16, default 4).
 
-    Latency: the first beat 22 clocks after ``start`` with an immediate memory (:data:`FIRST_PIXEL`); then
+    Latency: the first beat 24 clocks after ``start`` with an immediate memory (:data:`FIRST_PIXEL`); then
     8 clocks per stereo pixel pair with both sides in range (the two multipliers do four steps per
     side), fewer where a side is black; the memory's wait clocks add where the queue cannot hide them.
 

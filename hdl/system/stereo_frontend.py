@@ -23,6 +23,7 @@ from eyestereo.hdl.system.register_bank import RegisterPorts, register_bank
 from eyestereo.hdl.interfaces.sram_bus import HostPort, SramPins, StatPort, check_bundle
 from eyestereo.hdl.memory.sram_subsystem import sram_subsystem
 from eyestereo.hdl.interfaces.stream import ImageStream
+from eyestereo.hdl.streaming.queue_slice import queue_slice
 from eyestereo.hdl.streaming.stream_cdc import stream_cdc
 from eyestereo.hdl.streaming.word_cdc import word_cdc
 from eyestereo.tools.models import poly_unit as unit_model
@@ -48,7 +49,8 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     """The complete stereo front end of the thesis's Fig. 7.2, with the processor's register bus.
 
     Data flow: each camera bus -> :func:`~eyestereo.hdl.camera.camera_interface.camera_pair` (converter and
-    async FIFO into the memory clock) -> its double-buffered frame in the SRAM (the arbiter's camera
+    async FIFO into the memory clock; a :func:`~eyestereo.hdl.streaming.queue_slice.queue_slice` puts each
+    FIFO's port on flip-flops) -> its double-buffered frame in the SRAM (the arbiter's camera
     writers). When both frames of a pair are in, :func:`~eyestereo.hdl.system.frontend_sequencer.frontend_sequencer`
     starts the :func:`~eyestereo.hdl.rectify.rectifier.rectifier`, which reads them through the arbiter's fetch
     port; its 8-bit stereo stream goes both into the rectified-image buffers (the arbiter's rect writer:
@@ -127,10 +129,14 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
 
     insts = []
     # ---- cameras into the memory clock ---------------------------------------------------------
+    fifo0, fifo1 = QueuePort(CAMERA_WORD), QueuePort(CAMERA_WORD)
     cam0, cam1 = QueuePort(CAMERA_WORD), QueuePort(CAMERA_WORD)
     dropped_l, dropped_r = Signal(intbv(0)[16:]), Signal(intbv(0)[16:])
-    insts.append(camera_pair(cam_l, wrst_l, cam_r, wrst_r, clk, rst, cam0, cam1, dropped_l, dropped_r,
+    insts.append(camera_pair(cam_l, wrst_l, cam_r, wrst_r, clk, rst, fifo0, fifo1, dropped_l, dropped_r,
                              width=width, height=height, order=order, depth=cam_depth))
+    # the camera FIFOs' words come from block RAM: the camera writers' logic starts at flip-flops (issue 23:
+    # the block RAM's clock-to-output into the writer was the memory clock's critical path)
+    insts += [queue_slice(clk, rst, fifo0, cam0), queue_slice(clk, rst, fifo1, cam1)]
 
     # ---- SRAM subsystem and register bank --------------------------------------------------------
     fetch = FetchPort(width, height)
