@@ -109,8 +109,9 @@ test-time: setup
 	$(PY) -m eyestereo.sim.measure.suite_time --out docs/suite.md --jobs $(JOBS)
 
 # SymbiYosys proofs (k-induction, or bounded where stated) and covers of the property sets in formal/, then
-# their mutants, each of which must be rejected (docs/formal.md); make test runs the fast jobs (about 40 s),
-# the slow ones (tests/formal/test_formal.py's SLOW: register bank, sequencer, window filters, arbiter) only here.
+# their mutants, each of which must be rejected (docs/formal.md); make test runs the fast jobs (about 3 min),
+# the slow ones (tests/formal/test_formal.py's SLOW: register bank, sequencer, window filters, arbiter, feature
+# list) only here (about 11 min with their mutants).
 formal: setup
 	$(PY) formal/run.py
 	$(PY) formal/run.py --mutants

@@ -85,9 +85,22 @@ def _fresh(block: str):
     return conv
 
 
+def _queue_slice(path: Path, *, data_width: int) -> Path:
+    """queue_slice (a part of stereo_frontend, not a catalogue block) converted to Verilog in ``path``."""
+    from eyestereo.hdl.flow.catalog import fresh_ports
+    from eyestereo.hdl.interfaces.queue import QueuePort
+    from eyestereo.hdl.streaming.queue_slice import queue_slice
+
+    ports = fresh_ports(queue_slice, sink=QueuePort(data_width), source=QueuePort(data_width))
+    queue_slice(**ports).convert(hdl="Verilog", name="queue_slice", path=str(path), initial_values=True)
+    return path / "queue_slice.v"
+
+
 #: blocks that are not in the catalogue (or need a fresh conversion): their conversion (into a directory; the
 #: Verilog file)
-DIRECT = {"frontend_sequencer": _sequencer, **{b: _fresh(b) for b in ("sobel", "nms", "harris_window", "convolve")}}
+DIRECT = {"frontend_sequencer": _sequencer, "queue_slice": _queue_slice,
+          **{b: _fresh(b) for b in ("sobel", "nms", "harris_window", "convolve", "sram_arbiter", "cornerness",
+                                    "prethreshold", "stream_checker", "feature_list", "camera_stream")}}
 
 
 def _window(width: int, height: int, lead: int, latency: int, *, pre: int = 0, stereo: bool = False,
@@ -101,6 +114,28 @@ def _window(width: int, height: int, lead: int, latency: int, *, pre: int = 0, s
             f"`define F_ICAM {cams[0]}\n`define F_OCAM {cams[1]}\n"
             f"wire [7:0] f_skip = {p}skip, f_tail = {p}tail, f_wox = {p}ox, f_woy = {p}oy;\n"
             f"wire f_wv0 = {p}v0, f_wl0 = {p}l0, f_wf0 = {p}f0, f_wc0 = {cams[2]}, f_half = {cams[3]};\n")
+
+
+#: async_fifo_frames' mutants (the same edits in its port-only form)
+_FIFO_FRAME_MUTANTS = (
+    ("no token after an overflow (tok_pend not set when a pixel of a frame with words in the FIFO is lost)",
+     "else if ((tok_pend || full_s)) begin\n                if (mid) begin",
+     "else if ((tok_pend || full_s)) begin\n                if (1'b0) begin"),
+    ("no token after wrst (the abandoned frame's words left open)",
+     "if (wrst) begin\n        if (mid) begin", "if (wrst) begin\n        if (1'b0) begin"),
+    ("the dropped counter not incremented on an overflow", "inc = ((!bad) && (tok_pend || full_s));", "inc = 1'b0;"),
+    ("the counter's Gray-to-binary conversion without the running xor",
+     "b[i] = (b[(i + 1)] ^ cgray_s2[i]);", "b[i] = cgray_s2[i];"),
+    ("rrst inside a frame does not skip (skip cleared)", "skip <= (!q_eof);", "skip <= 1'b0;"),
+)
+#: the arbiter at the smallest parameters that elaborate (sram_arbiter, _wait, _fair, _turns)
+_ARB = dict(width=2, height=2, feature_words=2, depth=8, burst=2, fetch_burst=4, host_burst=1, counter_bits=16)
+#: the non-urgent round robin's mutants (sram_arbiter_fair, sram_arbiter_turns)
+_ARB_TURN_MUTANTS = (
+    ("the non-urgent pool leaves out host (host never chosen while another non-urgent master asks)",
+     "        pool = startv;\n", "        pool = (startv & 31);\n"),
+    ("the non-urgent round robin keeps no place (last1 never moves: fixed priority fetch, feat, host)",
+     "                last1 <= nxt;", "                last1 <= last1;"))
 
 
 @dataclass(frozen=True)
@@ -122,6 +157,15 @@ class Job:
     mutants: tuple[tuple[str, str, str], ...] = field(default=())
     #: Verilog put before the property file's `include (the localparams and defines of a shared property file)
     header: str = ""
+    #: a define the cover task reads the Verilog with (not the proof): e.g. a clock pattern for the covers only
+    cover_define: str = ""
+    #: the memories as flip-flops (``memory_map``) in the cover task and in bounded runs: Yices is far faster on
+    #: them than on SMT arrays in deep bounded runs (async_fifo_frames' cover: 9 s, not > 110 s), while the
+    #: k-induction is faster with the arrays
+    memory_map: bool = False
+    #: smtbmc options (``--nomem``: memories as bit vectors, not SMT arrays: feature_list's FIFO and counters take
+    #: seconds that way, minutes as arrays)
+    engine_opts: str = ""
 
 
 JOBS = {j.name: j for j in [
@@ -138,6 +182,37 @@ JOBS = {j.name: j for j in [
                   "assign we = ((!wrst) && (!full_s) && (", "assign we = ((!wrst) && ("),
                  ("empty one word early and not when really empty (rgray_nx == wgray_s2)",
                   "assign empty_s = (rgray == wgray_s2);", "assign empty_s = (rgray_nx == wgray_s2);"))),
+    # the queue port's frame rule (async_fifo_frames_props.vh): the writer tags every word (frame, index) in a
+    # ghost memory; the cover reads the Verilog with F_REGULAR_CLOCKS (both clocks every second step: with
+    # free clocks the covers' depth takes minutes), the proof keeps the clocks free
+    Job("async_fifo_frames", "async_fifo", dict(depth=4, data_width=2), "async_fifo_frames_props.vh",
+        "queue port frame rule (whole frames or a token after a prefix, a frame's first pixel after rrst), "
+        "dropped frames counted once, the counter's Gray crossing and catch-up (3 read edges)",
+        multiclock=True, mode="prove", depth=5, cover_depth=40, mutant_depth=24, cover_define="F_REGULAR_CLOCKS",
+        memory_map=True, mutants=_FIFO_FRAME_MUTANTS),
+    # the port properties alone (no write-side properties, no invariants), bounded: each mutant of
+    # async_fifo_frames also breaks a property a consumer of the port sees
+    Job("async_fifo_frames_port", "async_fifo", dict(depth=4, data_width=2), "async_fifo_frames_props.vh",
+        "the port properties of async_fifo_frames alone, bounded (frames whole or cut by a token, a frame's "
+        "first pixel after rrst, dropped = the ghost count)",
+        header="`define F_PORT_ONLY\n`define F_REGULAR_CLOCKS\n", multiclock=True, mode="bmc", depth=26,
+        cover_depth=40, memory_map=True, mutants=_FIFO_FRAME_MUTANTS),
+    Job("stream_cdc_tokens", "stream_cdc", dict(depth=4, data_width=2, stereo=True), "stream_cdc_tokens_props.vh",
+        "stereo: a sink pixel is a FIFO pixel and a sink token a FIFO token, the word carries the beat; a FIFO "
+        "token leaves as a token, a FIFO pixel as its beat (no pixel becomes a token, with async_fifo_frames)",
+        multiclock=True, mode="prove", depth=2, cover_depth=20, mutant_depth=12,
+        mutants=(("the left beat of a frame's last pixel turned into a FIFO token (fin_eof = sink_eof)",
+                  "assign fin_eof = (sink_eof && (sink_cam || (!sink_eol)));", "assign fin_eof = sink_eof;"),
+                 ("a FIFO eof pixel sent out as a token (the token test on q_eof alone)",
+                  "if ((q_eof && (!q_eol))) begin", "if (q_eof) begin"))),
+    Job("queue_slice", "queue_slice", dict(data_width=2), "queue_slice_props.vh",
+        "queue port in (rule assumed), free consumer: the rule out, every word out the next word in (none lost, "
+        "duplicated, reordered), at most 2 held, ready whenever there is room, 1 clock through an empty slice",
+        multiclock=False, mode="prove", depth=4, cover_depth=12, mutant_depth=10,
+        mutants=(("the skid word dropped when the consumer takes (out loaded from the queue, not the skid)",
+                  "if (skid_v) begin", "if (1'b0) begin"),
+                 ("ready not lowered by a full skid register (a third word taken in)",
+                  "assign sink_ready = (!skid_v);", "assign sink_ready = 1'b1;"))),
     Job("line_delay", "line_delay", dict(width=4, height=3, data_width=2), "line_delay_props.vh",
         "4x3 frames: protocol in => protocol out (eol/eof per beat count), pixel (x,y) carries (x,y-1)",
         multiclock=False, mode="prove", depth=8, cover_depth=30,
@@ -171,6 +246,26 @@ JOBS = {j.name: j for j in [
         header="`define F_REPAIR\n", multiclock=False, mode="prove", depth=15, cover_depth=30,
         mutants=(("the faulty beat leaves with its eol (not as a reset token)",
                   "source_eol <= (sink_eol && (!faulty));", "source_eol <= sink_eol;"),)),
+    Job("stream_checker_stereo", "stream_checker", dict(width=4, height=3, data_width=2, stereo=True),
+        "stream_checker_props.vh",
+        "stereo, any input (free beats of either camera, tokens, idle cycles): error/code equal a reference "
+        "checker's first fault (STEREO included); a good stereo stream never flagged; stream and cam passed unchanged",
+        header="`define F_STEREO\n", mode="prove", depth=15, cover_depth=40, mutant_depth=30,
+        mutants=(("a right beat whose eol differs from its left beat's not flagged",
+                  "if (((!sink_cam) || (sink_eol != left_eol) || (sink_eof != left_eof))) begin",
+                  "if (((!sink_cam) || (sink_eof != left_eof))) begin"),
+                 ("a reset token does not reset the camera phase (a token between a pixel's beats)",
+                  "if ((token || (bad && frame_end))) begin", "if (((bad && frame_end))) begin"))),
+    Job("stream_checker_stereo_repair", "stream_checker",
+        dict(width=4, height=3, data_width=2, stereo=True, repair=True), "stream_checker_props.vh",
+        "stereo, repair on, any input: error/code as stream_checker_stereo's; the output beat is the reference's "
+        "(faulty beat as a token, beats dropped to the recovery point); the source keeps the stereo protocol",
+        header="`define F_STEREO\n`define F_REPAIR\n", mode="prove", depth=15, cover_depth=40, mutant_depth=30,
+        mutants=(("the camera phase not reset at a broken frame's last beat (the next frame's left beat flagged)",
+                  "if ((token || (bad && frame_end))) begin", "if ((token)) begin"),
+                 ("a broken frame ends on the left camera's end-of-frame beat",
+                  "assign frame_end = (sink_valid && sink_eof && sink_eol && sink_cam);",
+                  "assign frame_end = (sink_valid && sink_eof && sink_eol);"))),
     # the point operations (point_props.vh): flags delayed by the block's latency (docstring), free input;
     # the frame size only checked by the blocks (the smallest, 1x1), the data widths fixed (57/20 bits)
     Job("cornerness", "cornerness", dict(width=1, height=1), "point_props.vh",
@@ -192,6 +287,43 @@ JOBS = {j.name: j for j in [
         mutants=(("the block row moves on by 1, not BX (a pixel of row 1 reads row 0's threshold)",
                   "block_position0_base <= (block_position0_base + 2);",
                   "block_position0_base <= (block_position0_base + 1);"),)),
+    Job("cornerness_stereo", "cornerness", dict(width=1, height=1, stereo=True), "point_props.vh",
+        "stereo, share 1, any input: valid/eol/eof/cam out = in 6 clocks before (none across rst), nothing out "
+        "while idle; the k register holds the beat's camera's k (k or k_right)",
+        header="localparam F_LAT = 6;\n`define F_STEREO\n`define F_KSEL\n", mode="prove", depth=8, cover_depth=12,
+        mutants=(("cam one clock short (5 stages)", "source_cam <= delay_rst3_dreg_rst22_q;",
+                  "source_cam <= delay_rst3_dreg_rst21_q;"),
+                 ("the right camera's beat takes the left k", "kq <= k_right;", "kq <= k;"))),
+    Job("cornerness_stereo_share2", "cornerness", dict(width=1, height=1, stereo=True, share=2), "point_props.vh",
+        "stereo, share 2 (multipliers over 2 clocks), any input: flags and cam out = in 5 clocks before, nothing "
+        "out while idle, the k register holds the beat's camera's k",
+        header="localparam F_LAT = 5;\n`define F_STEREO\n`define F_KSEL\n", mode="prove", depth=7, cover_depth=12,
+        mutants=(("cam one clock long (6 stages)", "source_cam <= delay_rst3_dreg_rst18_q;",
+                  "source_cam <= delay_rst3_dreg_rst17_q;"),)),
+    Job("cornerness_stereo_share3", "cornerness", dict(width=1, height=1, stereo=True, share=3), "point_props.vh",
+        "stereo, share 3, any input: as cornerness_stereo_share2",
+        header="localparam F_LAT = 5;\n`define F_STEREO\n`define F_KSEL\n", mode="prove", depth=7, cover_depth=12,
+        mutants=(("the left camera's beat takes k_right", "kq <= k;", "kq <= k_right;"),)),
+    Job("prethreshold_stereo", "prethreshold", dict(width=1, height=1, blocks=(1, 1), stereo=True), "point_props.vh",
+        "stereo, global threshold per camera (thr_addr bit 0 = cam), any input and writes: flags and cam out = in "
+        "1 clock before, a pixel passes if greater than its camera's threshold, else 0",
+        header="localparam F_LAT = 1;\n`define F_STEREO\n`define F_THRESHOLD\n", mode="prove", depth=6,
+        cover_depth=8,
+        mutants=(("the right camera's beat compared with the left threshold",
+                  "global_threshold0_thr = global_threshold0_stored_r;",
+                  "global_threshold0_thr = global_threshold0_stored;"),
+                 ("a write's camera taken from thr_addr bit 1", "if (thr_addr[0]) begin", "if (thr_addr[1]) begin"))),
+    Job("prethreshold_blocks_stereo", "prethreshold", dict(width=2, height=2, blocks=(2, 2), stereo=True),
+        "point_props.vh",
+        "stereo 2x2 frames in 2x2 blocks, stereo protocol in: as prethreshold_stereo, each beat against its own "
+        "block's and camera's threshold (2 * block + cam; the position moves on with the right beat)",
+        header="localparam F_LAT = 1;\n`define F_STEREO\n`define F_THRESHOLD\n`define F_BLOCKS\n", mode="prove",
+        depth=6, cover_depth=12, mutant_depth=12,
+        mutants=(("both cameras read the left camera's entry (address without cam)",
+                  "assign raddr = {blk, sink_cam};", "assign raddr = {blk, 1'b0};"),
+                 ("the position moves on with the left beat, not the right",
+                  "assign block_position0_step = (sink_valid && (sink_cam ||",
+                  "assign block_position0_step = (sink_valid && ((!sink_cam) ||"))),
     Job("stream_to_axis", "stream_to_axis", dict(width=3, height=2, data_width=2, depth=4), "stream_to_axis_props.vh",
         "protocol in, any tready: AXI4-Stream beats held until taken, TLAST every width-th beat, TUSER on "
         "a line's first beat and at most height lines a frame",
@@ -251,6 +383,38 @@ JOBS = {j.name: j for j in [
         mutants=(("the write hold-off window one clock short (a read 3 clocks back not seen)",
                   "assign block_w = ((rhist & 7) != 0);", "assign block_w = ((rhist & 3) != 0);"),
                  ("OE# one clock late", "sram_oe_n <= (!rpipe[(2 - 1)]);", "sram_oe_n <= (!rpipe[2]);"))),
+    Job("feature_list", "feature_list", dict(width=3, height=3, blocks=(1, 1), border=1, max_features=1, depth=4),
+        "feature_list_props.vh",
+        "stereo 3x3 flags (protocol in), free consumer: queue words held until taken, features = the list's flags "
+        "inside the border in stream order, trailer count/overflow exact, one list end per frame (trailer or "
+        "token), the FIFO never pushed when full (list ends assumed to find room: feature_list_fifo covers any "
+        "consumer), frame_done once per frame, totals/counts per camera",
+        mode="prove", depth=1, cover_depth=24, mutant_depth=24, engine_opts="--nomem",
+        mutants=(("a feature pushed beyond max_features (a second one listed)",
+                  "push = ((hit && (listed < 1) &&", "push = ((hit && (listed < 2) &&"),
+                 ("a flag that finds the list full does not set the overflow bit", "ovf <= 1'b1;", "ovf <= 1'b0;"),
+                 ("frame_done for a reset token too", "frame_done <= 1'b0;\n        if (token) begin",
+                  "frame_done <= token;\n        if (token) begin"))),
+    # the finding of feature_list (a trailer or token pushed into a full FIFO) and its fix, for any consumer
+    Job("feature_list_fifo", "feature_list", dict(width=3, height=3, blocks=(1, 1), border=1, max_features=1,
+                                                  depth=4), "feature_list_fifo_props.vh",
+        "any input, any consumer: nothing pushed into a full FIFO (a list end that finds it full is replaced by a "
+        "token when there is room; no feature listed meanwhile)",
+        header="localparam F_DEPTH = 4;\n", mode="prove", depth=4, cover_depth=40, mutant_depth=30,
+        engine_opts="--nomem",
+        mutants=(("a list end pushed whatever the FIFO holds (the form the feature_list job found)",
+                  "((last || token || lost_end) && (fcount < 4))", "(last || token || lost_end)"),)),
+    Job("camera_stream", "camera_stream", dict(width=2, height=2, luma=False), "camera_stream_props.vh",
+        "2x2 frames, YUYV, free camera bus (VSYNC, HREF, bytes on any clock), rst free: the output beat = a "
+        "reference receiver's (whole frames only, {U,Y0} {V,Y1} words, a token for a broken frame after a word); "
+        "protocol out whatever the bus; pixel beats 2 clocks apart",
+        mode="prove", depth=4, cover_depth=20, mutant_depth=16,
+        mutants=(("HREF dropped mid-line not an abort (n != 0 only)",
+                  "abort = ((n != 0) && (n != 4));", "abort = 1'b0;"),
+                 ("the odd word's chroma from the pair's U (pend <= {b1, b2})", "pend <= {d_r, b2};",
+                  "pend <= {b1, b2};"),
+                 ("a token for a broken frame of which no word came out (abort without started)",
+                  "if ((abort && started)) begin", "if (abort) begin"))),
     # the window filters (window_props.vh, one property file for all): 3x3 windows on 3x3 frames, 5x5 on 5x5
     Job("sobel", "sobel", dict(width=3, height=3), "window_props.vh",
         "3x3 frames: protocol in => protocol out, one output frame per input frame (a token cuts the tail), "
@@ -314,8 +478,7 @@ JOBS = {j.name: j for j in [
                  ("the older of two FULL buffers taken", "take_buf = newest;", "take_buf = (!newest);"),
                  ("the held (READING) buffer may be given to the producer",
                   "ok0 = (((s0 == 0) || (s0 == 2))", "ok0 = (((s0 == 0) || (s0 == 2) || (s0 == 3))"))),
-    Job("sram_arbiter", "sram_arbiter", dict(width=2, height=2, feature_words=2, depth=8, burst=2, fetch_burst=4,
-                                             host_burst=1, counter_bits=16), "sram_arbiter_props.vh",
+    Job("sram_arbiter", "sram_arbiter", _ARB, "sram_arbiter_props.vh",
         "six free masters, free frame handshake, controller within its contract (pipelined, read latency 1): "
         "at most one master granted, only the owner, each command the owner's access held until taken; "
         "every master granted (covers)",
@@ -323,9 +486,7 @@ JOBS = {j.name: j for j in [
         mutants=(("cam0 granted with cam1's accesses too (two masters in one clock)",
                   "g[i] = (iss && ($signed({1'b0, own}) == i));",
                   "g[i] = (iss && (($signed({1'b0, own}) == i) || ((i == 0) && (own == 1))));"),)),
-    Job("sram_arbiter_wait", "sram_arbiter", dict(width=2, height=2, feature_words=2, depth=8, burst=2,
-                                                  fetch_burst=4, host_burst=1, counter_bits=16),
-        "sram_arbiter_wait_props.vh",
+    Job("sram_arbiter_wait", "sram_arbiter", _ARB, "sram_arbiter_wait_props.vh",
         "same environment: an urgent writer (cam0, cam1, rect) that asks moves a word (or drops one) within 12 "
         "clocks, whatever the others do (12 is tight: 11 fails)",
         # bounded: the wait counter is not inductive without invariants of the six engines; BMC beyond ~22
@@ -333,6 +494,22 @@ JOBS = {j.name: j for j in [
         multiclock=False, mode="bmc", depth=22, cover_depth=18, timeout=300,
         mutants=(("the round robin skips cam0 (the choice loop stops above master 0)",
                   "for (i=(6 - 1)-1; i>=0; i=i-1) begin", "for (i=(6 - 1)-1; i>=1; i=i-1) begin"),)),
+    # the non-urgent masters (sram_arbiter_fair_props.vh): a bound in a reduced environment (cam0 the only urgent
+    # writer at a camera's rate, one word in 11 clocks; frame ends 44 clocks apart), turn fairness in the free one
+    Job("sram_arbiter_fair", "sram_arbiter", _ARB, "sram_arbiter_fair_props.vh",
+        "reduced environment (cam0 the only urgent writer, one word in 11 clocks, frame ends 44 clocks apart): "
+        "a non-urgent master (fetch, feat, host) that asks moves a word within 18 clocks (17 fails); no other "
+        "non-urgent master moves words in 3 turns chosen while it waits (2 do: 1 fails)",
+        header="`define F_NC 11\n`define F_NE 44\n`define F_BN 18\n`define F_FRAME_ENDS\n`define F_QUIET_CAM1\n"
+               "`define F_QUIET_RECT\n",
+        # bounded: a wait that starts in the first 9 steps is checked whole (the 17-clock trace ends at step 25)
+        multiclock=False, mode="bmc", depth=28, cover_depth=20, mutant_depth=20, timeout=300,
+        mutants=_ARB_TURN_MUTANTS),
+    Job("sram_arbiter_turns", "sram_arbiter", _ARB, "sram_arbiter_fair_props.vh",
+        "the free environment of sram_arbiter_wait (urgent writers at any rate): among the non-urgent masters "
+        "no master moves words in 3 turns chosen while another asks (2 do: 1 fails)",
+        header="`define F_FREE_URGENT\n", multiclock=False, mode="bmc", depth=20, cover_depth=20, timeout=300,
+        mutants=_ARB_TURN_MUTANTS),
 ]}
 
 
@@ -366,6 +543,13 @@ def find_tools() -> tuple[list[str], str]:
 def sby_text(job: Job, vfile: str, top: str, solver: str) -> str:
     mode = "prove" if job.mode == "prove" else "bmc"
     mc = "multiclock on\n" if job.multiclock else ""
+    read = f"read_verilog -formal {vfile}\n"
+    if job.cover_define:
+        read = f"prove: {read}cover: read_verilog -formal -D {job.cover_define} {vfile}\n"
+    mm = ""
+    if job.memory_map:
+        tasks = "" if job.mode == "bmc" else "cover: "
+        mm = f"{tasks}memory_map\n{tasks}opt_clean\n"
     return f"""[tasks]
 prove
 cover
@@ -378,12 +562,11 @@ cover: depth {job.cover_depth}
 {mc}timeout {job.timeout}
 
 [engines]
-smtbmc {solver}
+smtbmc {job.engine_opts + " " if job.engine_opts else ""}{solver}
 
 [script]
-read_verilog -formal {vfile}
-prep -top {top}
-
+{read}prep -top {top}
+{mm}
 [files]
 {vfile}
 {job.props}

@@ -65,8 +65,9 @@ def camera_stream(cam, rst, source, luma=None, *, width: int = FRAME_WIDTH, heig
 
     Latency: 1 PCLK: the even pixel's word is in the output register from the edge after the one that
     samples its pair's 4th byte; the odd pixel's word one edge later (with the next byte, or with the
-    first blanking sample for a line's last pair, which is when its ``eol`` is known). Words come at most
-    every other PCLK (a pair every 4).
+    first blanking sample for a line's last pair, which is when its ``eol`` is known). A pair's two words
+    come in consecutive PCLKs, a pair every 4 PCLKs (two words every 4 on average; found by the formal
+    proof's cover, docs/formal.md).
 
     Timing (a 4-pixel line, YUYV; a column per rising edge: the bus as that edge samples it, the output
     as that edge loads it; ``A``/``B``: the words of pixels 0/1, ``C``/``D`` of pixels 2/3)::

@@ -37,7 +37,10 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
     token on ``sink`` aborts the list with a queue reset token. The words are the format the SRAM
     feature writer (``sram_arbiter``'s ``feat`` port) stores and the host reads (see the model's
     module doc). At most ``max_features`` features per frame are listed; the others, and any that
-    find the FIFO full (the consumer held ``ready`` low too long), set the overflow flag.
+    find the FIFO full (the consumer held ``ready`` low too long), set the overflow flag. A list's end
+    that finds the FIFO full (a stall across two more frame ends) is replaced by a reset token as soon as
+    there is room, and no feature is listed until then: that list is aborted, lists that ended meanwhile
+    are dropped whole; a list is never closed with a wrong trailer, and no FIFO entry is overwritten.
 
     Counts: every feature is counted in a counter per (camera, threshold block) (BX x BY blocks as in
     the pre-threshold) and per camera. At the end of each frame (the right camera's last flag) they are
@@ -178,19 +181,36 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
     marker = Signal(intbv(model.MARKER)[16:])
     zero32 = Signal(intbv(0)[32:])
 
+    # A list's end (trailer or token) that finds the FIFO full (the consumer held ``ready`` low across two
+    # more frame ends: features stop at depth - 2, ends did not) is not pushed: an entry would be
+    # overwritten (found by the formal proof, docs/formal.md). ``lost_end`` remembers it; until a reset token
+    # is pushed in its place (at the first clock with room), no feature is listed, so the consumer sees the
+    # list whose end was lost cut by that token, and the lists that ended meanwhile not at all.
+    lost_end = Signal(bool(0))
+    room = Signal(bool(0))
+
     @always_comb
     def entry():
-        accept.next = hit and listed < max_features and fcount < depth - 2
+        room.next = fcount < depth
+        accept.next = hit and listed < max_features and fcount < depth - 2 and not lost_end
         fx.next = x
         fy.next = y
         tcount.next = listed
-        push.next = (hit and listed < max_features and fcount < depth - 2) or last or token
-        if token:
+        push.next = (hit and listed < max_features and fcount < depth - 2 and not lost_end) or (
+            (last or token or lost_end) and fcount < depth)
+        if token or lost_end:
             din.next = concat(k_token, zero32)
         elif last:
             din.next = concat(k_trailer, ovf, tcount, marker)
         else:
             din.next = concat(k_feature, fy, sink.cam, fx)
+
+    @always_seq(clk.posedge, reset=rst)
+    def ends():
+        if (last or token) and not room:
+            lost_end.next = True
+        elif lost_end and room:
+            lost_end.next = False
 
     @always_seq(clk.posedge, reset=rst)
     def lists():
@@ -262,5 +282,5 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
                 half.next = True
 
     return [decode, block_position(clk, rst, sink, x, y, blk, width=width, height=height, blocks=(bxn, byn)),
-            caddr, cflags, cread, cwrite, entry, lists, serial, halves,
+            caddr, cflags, cread, cwrite, entry, ends, lists, serial, halves,
             sync_fifo(clk, rst, din, push, dout, pop, fcount, fvalid, depth=depth)]

@@ -53,6 +53,7 @@ class Consumer:
         self.words: list[tuple] = []
         self.cycles: list[int] = []  # cycle each word was on the port (taken at the next edge)
         self.undefined: list[str] = []
+        self.hold = False  # ready held low (a consumer stalled across several frame ends)
         dut.source_ready.value = 0
         cocotb.start_soon(self._run())
 
@@ -60,7 +61,7 @@ class Consumer:
         dut = self.dut
         while True:
             await RisingEdge(dut.clk)
-            r = int(self.ready >= 1.0 or self.rng.random() < self.ready)
+            r = int(not self.hold and (self.ready >= 1.0 or self.rng.random() < self.ready))
             dut.source_ready.value = r
             await ReadOnly()
             v = dut.source_valid.value
@@ -142,6 +143,13 @@ async def feature_list_frames(dut):
         results.append(res)
         expected_words += res["words"]
     source.send_beats(beats)
+    if cfg.get("stall"):
+        # the consumer takes nothing while every frame goes in: its lists' ends find the FIFO full
+        consumer.hold = True
+        while source.queue:
+            await ClockCycles(dut.clk, 16)
+        await ClockCycles(dut.clk, 16)
+        consumer.hold = False
     limit = int(len(beats) / cfg.get("duty", 1.0) * 2) + 2000
     waited = 0
     while (source.queue or len(consumer.words) < len(expected_words)) and waited < limit:
@@ -154,7 +162,29 @@ async def feature_list_frames(dut):
     if cfg.get("debug"):
         import json
         open(cfg["report"] + ".debug", "w").write(json.dumps(dict(got=got, exp=expected_words)))
-    if cfg.get("lossy"):
+    if cfg.get("stall"):
+        # Frame ends during the stall that found the FIFO full: their lists are lost, and the list whose end
+        # was the first lost is cut by a reset token, the last word out (never a trailer that closes it
+        # with another frame's features, never an overwritten entry). The lists before it are whole: each
+        # the model's list with features left out (those that found the FIFO full), the count and flag right.
+        lists_got = model.parse_words(got)
+        assert lists_got and lists_got[-1].get("aborted"), f"the last list must be cut by a token: {lists_got}"
+        whole = lists_got[:-1]
+        assert all(not lst.get("aborted") for lst in whole), f"a token before the end: {lists_got}"
+        assert 1 <= len(whole) < len(results), f"{len(whole)} whole lists of {len(results)} frames"
+        for i, (lst, res) in enumerate(zip(whole, results)):
+            it = iter(res["features"])
+            assert all(f in it for f in lst["features"]), f"list {i}: not a subsequence of the model's"
+            assert lst["count"] == len(lst["features"]), f"list {i}: count {lst['count']}"
+            missing = len(lst["features"]) < len(res["features"])
+            assert lst["overflow"] == (missing or res["overflow"]), f"list {i}: overflow {lst['overflow']}"
+        assert not lists_got[-1]["features"], "features listed after a lost end"
+        # the counts are published for every frame; a lost list's flag says its list was cut
+        for i in range(len(whole), len(results)):
+            results[i] = dict(results[i], overflow=results[i]["overflow"] or bool(results[i]["features"]))
+        for i, lst in enumerate(whole):
+            results[i] = dict(results[i], overflow=lst["overflow"])
+    elif cfg.get("lossy"):
         # A consumer that stalls too long: the FIFO fills and features are dropped. Each whole list must
         # be the model's list with features left out (order kept), its trailer counting what is listed,
         # and the overflow flag set wherever a feature is missing; the counts below count them all.

@@ -18,15 +18,23 @@ RUN = ROOT / "formal" / "run.py"
 #: the jobs run here: each proof + cover and its mutants take 3 to 9 s (conversion included) on a quiet machine
 FAST = ("word_cdc", "async_fifo", "line_delay", "line_delay_stereo", "stream_checker", "stream_checker_repair",
         "cornerness", "prethreshold", "prethreshold_blocks", "stream_to_axis", "axis_to_stream", "stream_cdc",
-        "sram_controller", "sobel", "double_buffer")
+        "sram_controller", "sobel", "double_buffer", "async_fifo_frames", "stream_cdc_tokens",
+        "queue_slice", "stream_checker_stereo", "stream_checker_stereo_repair", "cornerness_stereo",
+        "cornerness_stereo_share2", "cornerness_stereo_share3", "prethreshold_stereo", "prethreshold_blocks_stereo",
+        "feature_list_fifo", "camera_stream")
 #: jobs only in `make formal`, left out so that this file stays under about a minute (about 9 s each with
 #: their mutants): register_bank (the whole register map's conversion), frontend_sequencer (k = 20, three
 #: mutants); the window filters but sobel (window_props.vh, as sobel: 10 to 90 s each with their mutants, the
 #: stereo ones' covers run a whole stereo frame and its tail)
 SLOW: tuple[str, ...] = ("register_bank", "frontend_sequencer", "sobel_stereo", "sobel_stereo_share2", "nms",
                          "nms_stereo", "harris_window", "harris_window_stereo", "convolve",
-                         # the SRAM arbiter: about 10 s (k = 8 on the whole arbiter) and 45 s (bmc depth 22)
-                         "sram_arbiter", "sram_arbiter_wait")
+                         # the SRAM arbiter: about 10 s (k = 8 on the whole arbiter) and 45 s (bmc depth 22);
+                         # the non-urgent masters' bound and turns: about 1 to 3 min each (bmc depth 28 / 20)
+                         "sram_arbiter", "sram_arbiter_wait", "sram_arbiter_fair", "sram_arbiter_turns",
+                         # async_fifo_frames' port properties alone: bmc depth 26 (its mutants five times that)
+                         "async_fifo_frames_port",
+                         # feature_list's lists: the induction step on the whole block, about 20 to 30 s
+                         "feature_list")
 
 
 def run(*args: str) -> subprocess.CompletedProcess:

@@ -40,3 +40,15 @@ def test_feature_list_consumer_stall_drops_and_flags(request):
                        name=request.node.name,
                        params=dict(width=23, height=13, blocks=(2, 2), border=3, max_features=1023, depth=4))
     assert report["frames"] == 2 and all(report["overflow"])
+
+
+@pytest.mark.parametrize("frames", [3, 5])
+def test_feature_list_lists_ends_lost_in_a_long_stall(request, frames):
+    """Regression of a formal finding (docs/formal.md, feature_list): the consumer takes nothing while
+    several frames end; the ends that find the FIFO full are replaced by one reset token (no FIFO entry
+    overwritten, no list closed with a wrong trailer), the lists before are whole, the counts exact."""
+    report = run_bench("feature_list", "tb_feature_list",
+                       dict(frames=["flags:0.3"] * frames, duty=1.0, ready=1.0, seed=5, stall=True),
+                       name=request.node.name,
+                       params=dict(width=7, height=5, blocks=(1, 1), border=1, max_features=1023, depth=4))
+    assert report["frames"] == frames and report["lists"] < frames + 1
