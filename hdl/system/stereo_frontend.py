@@ -8,7 +8,8 @@ from eyestereo.hdl.streaming.async_fifo import MAX_DEPTH
 from eyestereo.hdl.interfaces.axil import check_axil
 from eyestereo.hdl.camera.camera_stream import check_camera
 from eyestereo.hdl.camera.camera_interface import camera_pair
-from eyestereo.hdl.common.checks import block_error, check_choice, check_clock, check_int, check_reset
+from eyestereo.hdl.common.checks import block_error, check_bool, check_choice, check_clock, check_int, check_reset
+from eyestereo.hdl.common.registers import assign
 from eyestereo.hdl.harris.feature_list import addr_bits, count_bits, feature_list
 from eyestereo.hdl.rectify.fetch_interpolate import DEFAULT_DEPTH
 from eyestereo.hdl.interfaces.fetch_port import FetchPort
@@ -45,7 +46,8 @@ THR_BITS = REGMAP["THR_LEFT"].fields[0].width
 def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sram, *, quantizers="rig",
                     frac: int | None = unit_model.DEFAULT_FRAC, nms: int = NMS_DEFAULT, border: int | None = None,
                     max_features: int = 1023, feature_words: int = 2048, cam_depth: int = 1024,
-                    kind: str = "nobl", read_latency: int = 2, order: str = "YUYV", rect_depth: int = DEFAULT_DEPTH):
+                    kind: str = "nobl", read_latency: int = 2, order: str = "YUYV", rect_depth: int = DEFAULT_DEPTH,
+                    single_clock: bool = False):
     """The complete stereo front end of the thesis's Fig. 7.2, with the processor's register bus.
 
     Data flow: each camera bus -> :func:`~eyestereo.hdl.camera.camera_interface.camera_pair` (converter and
@@ -70,7 +72,8 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
         clk, rst: the memory clock (100 MHz: SRAM, arbiter, rectifier, feature list, register bus) and
             its synchronous active-high reset.
         hclk, hrst: the Harris clock (50 MHz in the thesis; harris_stereo, built with share 1, takes a beat
-            per clock, so any hclk of at least half the memory clock keeps up with the rectifier) and its reset.
+            per clock, so any hclk of at least half the memory clock keeps up with the rectifier) and its reset;
+            not used with ``single_clock`` (tie them to ``clk``/``rst`` or leave them open).
         cam_l, wrst_l, cam_r, wrst_r: the camera buses (:class:`~eyestereo.hdl.interfaces.camera_bus.CameraBus`,
             each clocked by its own PCLK) and each camera domain's synchronous reset.
         bus: :class:`~eyestereo.hdl.interfaces.axil.AxiLite` slave (the register map's address bits), memory clock.
@@ -88,6 +91,10 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
         kind, read_latency: the SRAM part (sram_controller).
         order: the cameras' byte order.
         rect_depth: fetch_interpolate's sides in flight.
+        single_clock: False (default): harris_stereo in its own clock ``hclk``, the rectified stream, k, the
+            thresholds and the flags cross through stream_cdc / word_cdc; True: harris_stereo in the memory
+            clock, wired straight (no crossings, HARRIS_OVF stays 0; the whole Harris chain must then meet
+            the memory clock: docs/benchmarks.md).
 
     Latency: a frame's features are complete a few lines (Harris's lead, :func:`harris_stereo.latency`)
     after the rectifier's last beat; the sequencer's ``frame_clocks`` measures the whole.
@@ -123,6 +130,7 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     kind = check_choice("kind", kind, KINDS)
     read_latency = check_int("read_latency", read_latency, 1, 3)
     order = check_choice("order", order, ORDERS)
+    single_clock = check_bool("single_clock", single_clock)
     rect_depth = check_int("rect_depth", rect_depth, 1, 16)
     if frac is not None:
         frac = check_int("frac", frac, 0, unit_model.MAX_FRAC)
@@ -157,19 +165,26 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
                                     r_busy, l_done, l_ovf, regs.busy, regs.frames, regs.frame_clocks,
                                     regs.list_overflows))
 
-    # ---- into the Harris clock and back --------------------------------------------------------------
-    h_in = ImageStream(8, stereo=True)
-    h_dropped, h_dropped_m = Signal(intbv(0)[16:]), Signal(intbv(0)[16:])
-    insts.append(stream_cdc(clk, rst, rect, hclk, hrst, h_in, h_dropped, depth=16))
-    insts.append(word_cdc(hclk, h_dropped, clk, h_dropped_m))
-
+    # ---- into the Harris clock and back (or, single_clock, straight) ------------------------------------
+    hclk_, hrst_ = (clk, rst) if single_clock else (hclk, hrst)
+    h_in = rect if single_clock else ImageStream(8, stereo=True)
+    h_dropped_m, f_dropped = Signal(intbv(0)[16:]), Signal(intbv(0)[16:])
     k_m, k_h = Signal(intbv(0)[16:]), Signal(intbv(0)[16:])
     k_l_h, k_r_h = Signal(intbv(0)[8:]), Signal(intbv(0)[8:])
-    insts.append(word_cdc(clk, k_m, hclk, k_h))
     tbits = 1 + 4 + THR_BITS
-    thr_m, thr_h = ImageStream(tbits), ImageStream(tbits)
-    thr_dropped = Signal(intbv(0)[16:])
-    insts.append(stream_cdc(clk, rst, thr_m, hclk, hrst, thr_h, thr_dropped, depth=16))
+    thr_m = ImageStream(tbits)
+    thr_h = thr_m if single_clock else ImageStream(tbits)
+    h_flags = ImageStream(1, stereo=True)
+    flags = h_flags if single_clock else ImageStream(1, stereo=True)
+    if single_clock:
+        insts.append(assign(k_m, k_h))
+    else:
+        h_dropped, thr_dropped = Signal(intbv(0)[16:]), Signal(intbv(0)[16:])
+        insts.append(stream_cdc(clk, rst, rect, hclk, hrst, h_in, h_dropped, depth=16))
+        insts.append(word_cdc(hclk, h_dropped, clk, h_dropped_m))
+        insts.append(word_cdc(clk, k_m, hclk, k_h))
+        insts.append(stream_cdc(clk, rst, thr_m, hclk, hrst, thr_h, thr_dropped, depth=16))
+        insts.append(stream_cdc(hclk, hrst, h_flags, clk, rst, flags, f_dropped, depth=16))
     thr_we, thr_cam = Signal(bool(0)), Signal(bool(0))
     thr_addr, thr_data = Signal(intbv(0)[4:]), Signal(intbv(0)[THR_BITS:])
 
@@ -194,11 +209,8 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
         thr_data.next = thr_h.data[THR_BITS:0]
 
     insts += [to_harris_m, to_harris_h]
-    h_flags, flags = ImageStream(1, stereo=True), ImageStream(1, stereo=True)
-    insts.append(harris_stereo(hclk, hrst, h_in, h_flags, k_l_h, k_r_h, thr_we, thr_cam, thr_addr, thr_data,
+    insts.append(harris_stereo(hclk_, hrst_, h_in, h_flags, k_l_h, k_r_h, thr_we, thr_cam, thr_addr, thr_data,
                                width=width, height=height, blocks=BLOCKS, nms=nms, share=1))
-    f_dropped = Signal(intbv(0)[16:])
-    insts.append(stream_cdc(hclk, hrst, h_flags, clk, rst, flags, f_dropped, depth=16))
 
     # ---- feature list, counts -----------------------------------------------------------------------------
     cb = count_bits(width, height)

@@ -31,15 +31,17 @@ TIMING = dict(h_blank=8, v_sync=1, v_back=1, v_front=1)
 
 
 @pytest.mark.sim
-@pytest.mark.parametrize("mode", ["sequential", "overlapped"])
-def test_stereo_frontend(request, mode):
+@pytest.mark.parametrize("mode,single_clock", [("sequential", False), ("overlapped", False), ("sequential", True)])
+def test_stereo_frontend(request, mode, single_clock):
+    """single_clock: harris_stereo in the memory clock, no crossings (issue 23's build option); the same chain."""
     rep = run_bench("stereo_frontend", "tb_stereo_frontend",
                     dict(mode=mode, frames=FRAMES[mode], images="shift:3", timing=TIMING, require_features=True,
                          pause=0.1 if mode == "sequential" else 0.0,
                          # sequential: the host closes the threshold loop (thesis 7.2), a quarter feature per
                          # block wanted
                          adaptive=0.25 if mode == "sequential" else None),
-                    name=request.node.name, params=dict(quantizers=SPEC, feature_words=256, max_features=127))
+                    name=request.node.name, params=dict(quantizers=SPEC, feature_words=256, max_features=127,
+                                                        single_clock=single_clock))
     n = FRAMES[mode]
     assert rep["bit_exact"] and len(rep["frames"]) == n
     # the captured pairs move on, frame after frame
