@@ -17,8 +17,9 @@
 //     total_right and count_data = the flags inside the border per camera of the last whole frame; overflow
 //     = the last whole frame's overflow bit (a flag not listed).
 // Invariants (they close the induction, k = 1): the FIFO's words in order continue the output list (each
-// checked as above against the input's lists), the block's position, counters and counter banks equal the
-// reference's.
+// checked as above against the input's lists), the block's position (and its last-column / -row flags),
+// its inside-the-border flags, counters and counter banks equal the reference's; the counter register read a
+// clock ahead holds the count of the beat due.
 localparam F_W = 3, F_H = 3, F_B = 1, F_MAX = 1, F_DEPTH = 4;
 // An undeclared name (e.g. a register MyHDL named otherwise) is an error, not an implicit 1-bit wire.
 `default_nettype none
@@ -227,13 +228,17 @@ always @(*) begin
     // the input's list: the features listed so far, all before the input's position
     if (!(f_l == f_lin && f_c == listed && (!f_hp || f_pv < {f_iy, f_ix, f_iph}))) f_fok = 1'b0;
 end
-wire [3:0] f_fcnt = bank ? fresh1 : fresh0;  // the counting bank's fresh flags
-wire [3:0] f_fpub = bank ? fresh0 : fresh1;  // the published bank's
+wire [3:0] f_fcnt = fcnt;  // the counting bank's fresh flags
+wire [3:0] f_fpub = fpub;  // the published bank's
 always @(*) if (f_past) begin
     assert(f_fok);
     assert(f_ocnt <= F_MAX && f_ocnt <= f_onflag);  // the output list's features so far
     assert(x == f_ix && y == f_iy && blk == 1'b0 && f_ix < F_W && f_iy < F_H);
     assert(block_position0_bx == 1'b0 && block_position0_by == 1'b0 && block_position0_base == 1'b0);  // one block
+    // the last-column / -row flags (one block: its last column / row is the frame's)
+    assert(block_position0_xe == (f_ix == F_W - 1) && block_position0_xw == (f_ix == F_W - 1));
+    assert(block_position0_ye == (f_iy == F_H - 1) && block_position0_yh == (f_iy == F_H - 1));
+    assert(inx == (f_ix >= F_B && f_ix < F_W - F_B) && iny == (f_iy >= F_B && f_iy < F_H - F_B));  // the border
     // the FIFO's bookkeeping
     assert(fcount == sync_fifo0_stored + fvalid && sync_fifo0_stored <= F_DW);
     assert(sync_fifo0_wp == ((sync_fifo0_rp + sync_fifo0_stored) % F_DW));
@@ -248,6 +253,8 @@ always @(*) if (f_past) begin
     assert(tot0 == f_hl && tot1 == f_hr);
     assert((f_fcnt[0] ? cmem[{bank, 2'b00}] : 4'd0) == f_hl && (f_fcnt[1] ? cmem[{bank, 2'b01}] : 4'd0) == f_hr);
     assert((f_fpub[0] ? cmem[{!bank, 2'b00}] : 4'd0) == f_tl && (f_fpub[1] ? cmem[{!bank, 2'b01}] : 4'd0) == f_tr);
+    // the counter of the beat due (its camera the one after the last beat's), read a clock ahead
+    assert(due == f_iph && cur == (f_iph ? f_hr : f_hl));
     assert(f_hl <= 4'd1 && f_hr <= 4'd1 && f_tl <= 4'd1 && f_tr <= 4'd1);  // one pixel inside the border
     assert(f_nflag[3 * f_lin +: 3] == f_hl + f_hr && f_mask[4 * f_lin +: 4] == {2'b00, f_hr[0], f_hl[0]});
     if (f_hl) assert({f_iy, f_ix, f_iph} > {2'd1, 2'd1, 1'b0});  // the flags of this frame: beats gone by

@@ -8,7 +8,9 @@
 //   * nothing comes out after F_LAT idle clocks (nor in the F_LAT clocks after rst);
 //   * prethreshold: an output pixel is the input pixel where that was greater than its block's threshold
 //     (written through thr_we/thr_addr/thr_data, 0 after rst, signed), else 0. One block (blocks (1, 1)),
-//     or, with `define F_BLOCKS, 2x2 frames in 2x2 blocks (then the input protocol is assumed).
+//     or, with `define F_BLOCKS, 2x2 frames in 2x2 blocks (then the input protocol is assumed; the table is
+//     read a clock ahead, so a write counts from the second clock after it, and a reset token is compared
+//     with the threshold of the beat due: its position's, on a stereo stream the camera due).
 // Stereo (header `define F_STEREO): cam is a flag like eol and eof (it passes at the latency); prethreshold's
 // thresholds are per camera (thr_addr = 2 * block + cam: one register per camera for blocks (1, 1), whose
 // block bits are not looked at; a table of 8 entries for 2x2 blocks, the position moving on with the right
@@ -66,7 +68,7 @@ always @(*) begin
 end
 `ifdef F_STEREO
 localparam F_NT = 8;  // table entries
-wire [2:0] f_idx = {f_iy, f_ix, sink_cam};
+wire [2:0] f_idx = {f_iy, f_ix, f_iph};  // = sink_cam on a pixel beat; a token: the camera due
 wire f_istep = f_ipix && f_iph;  // the right beat ends the pixel
 `else
 localparam F_NT = 4;
@@ -90,12 +92,26 @@ always @(posedge clk) begin
     if (rst) f_wr <= 0;
     else if (thr_we) f_wr[thr_addr] <= 1'b1;
 end
-always @(*) f_thr = f_wr[f_idx] ? f_tab[20 * f_idx +: 20] : 20'd0;
+// the table one clock late (read a clock ahead: a write counts from the second clock after it; after rst 0)
+reg [20*F_NT-1:0] f_tab_d = 0;
+reg [F_NT-1:0] f_wr_d = 0;
+always @(posedge clk) begin
+    f_tab_d <= f_tab;
+    f_wr_d <= rst ? {F_NT{1'b0}} : f_wr;
+end
+always @(*) f_thr = f_wr_d[f_idx] ? f_tab_d[20 * f_idx +: 20] : 20'd0;
 // invariants (they close the induction): the block position and the table agree with the reference
 always @(*) if (f_past) begin
     assert(x == f_ix && y == f_iy && blk == {f_iy, f_ix});
     assert(block_position0_bx == f_ix && block_position0_by == f_iy && block_position0_base == {f_iy, 1'b0});
+    // the last-column / -row flags (every block one pixel: always its last), the frame's last column / row
+    assert(block_position0_xe && block_position0_ye);
+    assert(block_position0_xw == f_ix && block_position0_yh == f_iy);
     assert(written == f_wr);
+    assert(thr == f_thr);  // the threshold register: the beat due's, read a clock ahead
+`ifdef F_STEREO
+    assert(due == f_iph);
+`endif
     for (f_k = 0; f_k < F_NT; f_k = f_k + 1) assert(mem[f_k] == f_tab[20 * f_k +: 20]);
 end
 `else

@@ -2,7 +2,7 @@
 
 from myhdl import Signal, always_comb, block, intbv
 
-from eyestereo.hdl.common.registers import assign
+from eyestereo.hdl.common.registers import assign, delay
 
 
 def csd(k: int) -> list[tuple[int, int]]:
@@ -77,6 +77,32 @@ def shift_add(terms, out):
     if lo < olo or hi > ohi:
         raise ValueError(f"shift_add output range [{olo}, {ohi}] cannot hold the sum's [{lo}, {hi}]")
     insts.append(assign(root, out))
+    return insts
+
+
+@block
+def chain_sum(clk, terms, out):
+    """Registered ``out = sum(coeff * sig)`` of terms that come one clock apart, as a chain of adders.
+
+    ``terms[j]`` is read ``j`` clocks after ``terms[0]`` (the skewed column taps of
+    :func:`~eyestereo.hdl.streaming.window.column_taps`); ``out`` holds the sum ``len(terms)`` clocks after
+    ``terms[0]``. Each clock adds one term to the registered partial sum of the terms before it, so a
+    register holds each partial sum, not each term until the last one comes (fewer registers when the
+    terms would wait several clocks), and no path has more than one term's shifts and adds.
+    """
+    insts = []
+    acc, lo, hi = None, 0, 0
+    for j, (sig, coeff) in enumerate(terms):
+        tlo, thi = term_range(sig, int(coeff))
+        lo, hi = lo + tlo, hi + thi
+        part = [(sig, coeff)] if acc is None else [(acc, 1), (sig, coeff)]
+        s = range_signal(lo, hi)
+        nxt = out if j == len(terms) - 1 else range_signal(lo, hi)
+        insts += [shift_add(part, s), delay(clk, s, nxt, clocks=1)]
+        acc = nxt
+    olo, ohi = signal_range(out)
+    if lo < olo or hi > ohi:
+        raise ValueError(f"chain_sum output range [{olo}, {ohi}] cannot hold the sum's [{lo}, {hi}]")
     return insts
 
 

@@ -69,8 +69,11 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
     measured by the bench).
     Throughput: one word per clock, one feature per 2 clocks sustained; the FIFO absorbs bursts.
 
-    Resources: the FIFO (34 x depth LUT-RAM), 2 x 2 x BX BY counters in LUT-RAM, the
-    block position counters (:func:`~eyestereo.hdl.harris.block_position.block_position`).
+    Resources: the FIFO (34 x depth LUT-RAM), 2 x 2 x BX BY counters in LUT-RAM (read at two addresses
+    besides the write's: the counter of the beat due, a clock ahead, and the published count; on a
+    LUT-RAM with one read port of its own, as the Spartan-3E's, two copies), the counter register, the
+    block position counters (:func:`~eyestereo.hdl.harris.block_position.block_position`) and two border
+    flags.
     """
     check_clock(clk)
     check_reset(rst)
@@ -101,32 +104,66 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
     x = Signal(intbv(0, min=0, max=width))
     y = Signal(intbv(0, min=0, max=height))
     blk = Signal(intbv(0)[ab - 1:])
+    ahead = Signal(intbv(0)[ab - 1:])  # the block of the next beat
     token = Signal(bool(0))
     last = Signal(bool(0))  # the right camera's beat of the frame's last pixel
     hit = Signal(bool(0))  # a listed feature on this beat (not "event": a Verilog keyword)
-    x_lo, x_hi, y_lo, y_hi = border, width - border, border, height - border
+    step = Signal(bool(0))  # the position moves on (as in block_position)
+    inx, iny = Signal(bool(0)), Signal(bool(0))  # x / y inside the border
+    # the column / row before the first inside and before the first outside the border; the frame's last
+    x_in, x_out, y_in, y_out = border - 1, width - border - 1, border - 1, height - border - 1
+    x_end, y_end = width - 1, height - 1
 
     @always_comb
     def decode():
         token.next = sink.valid and sink.eof and not sink.eol
         last.next = sink.valid and sink.eof and sink.eol and sink.cam
-        hit.next = sink.valid and not (sink.eof and not sink.eol) and sink.data[0] and x >= x_lo and x < x_hi \
-            and y >= y_lo and y < y_hi
+        step.next = sink.valid and (sink.cam or (sink.eof and not sink.eol))
+        hit.next = sink.valid and not (sink.eof and not sink.eol) and sink.data[0] and inx and iny
+
+    # Inside the border, as flags that follow the position (the moves of block_position): set one pixel
+    # before the first column / row inside, cleared one before the first outside (both at once when no
+    # column / row is inside), so that a beat's hit takes no comparison. Column and row 0 are outside.
+    @always_seq(clk.posedge, reset=rst)
+    def borders():  # (not "inside": a SystemVerilog keyword)
+        if step:
+            if sink.eof:
+                inx.next = False
+                iny.next = False
+            elif sink.eol or x == x_end:
+                inx.next = False
+                if y == y_end:
+                    iny.next = False
+                else:
+                    iny.next = (iny or y == y_in) and y != y_out
+            else:
+                inx.next = (inx or x == x_in) and x != x_out
 
     # Counters: LUT-RAM of 2 banks x 2^ab entries, address (bank, block, cam); a "fresh" flag per entry
-    # and bank says it was written in its bank's frame (a cleared flag reads as 0), so a bank is
-    # cleared in one clock.
+    # says it was written in its bank's frame (a cleared flag reads as 0), so a bank is cleared in one
+    # clock. The flags are kept as the counting bank's and the published bank's (they move over when the
+    # banks swap). The counter of the beat due next and its flag are read a clock ahead (its block from
+    # the block position's ``ahead``, its camera the one after the last beat's: left after a right beat or
+    # a token) into registers; the increment starts from them. On the stereo protocol no beat's counter is
+    # the one its predecessor (the clock before) writes; a beat that breaks the left-right order (two of
+    # one camera in turn) is counted from the other camera's counter.
     nent = 1 << ab
     cmem = [Signal(intbv(0)[cb:]) for _ in range(2 * nent)]
-    fresh0 = Signal(intbv(0)[nent:])
-    fresh1 = Signal(intbv(0)[nent:])
+    fcnt = Signal(intbv(0)[nent:])  # the counting bank's flags
+    fpub = Signal(intbv(0)[nent:])  # the published bank's
     bank = Signal(bool(0))
     nbank = Signal(bool(0))
     cidx = Signal(intbv(0)[ab:])
     waddr = Signal(intbv(0)[ab + 1:])
     raddr = Signal(intbv(0)[ab + 1:])
-    wfresh = Signal(bool(0))
     rfresh = Signal(bool(0))
+    due = Signal(bool(0))  # the camera of the beat due now
+    due_next = Signal(bool(0))
+    aidx = Signal(intbv(0)[ab:])  # (block, cam) of the beat due next
+    aaddr = Signal(intbv(0)[ab + 1:])
+    afresh = Signal(bool(0))
+    aread = Signal(intbv(0)[cb:])  # the counter of the beat due, registered, and its flag
+    afresh_q = Signal(bool(0))
     cur = Signal(intbv(0)[cb:])
     tot0 = Signal(intbv(0)[cb:])
     tot1 = Signal(intbv(0)[cb:])
@@ -142,23 +179,32 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
 
     @always_comb
     def cflags():
-        if bank:
-            wfresh.next = fresh1[cidx]
-            rfresh.next = fresh0[count_addr]
+        if sink.valid:
+            due_next.next = not sink.cam and not (sink.eof and not sink.eol)
         else:
-            wfresh.next = fresh0[cidx]
-            rfresh.next = fresh1[count_addr]
+            due_next.next = due
+        aidx.next = concat(ahead, due_next)
+        aaddr.next = concat(bank, ahead, due_next)
+        afresh.next = fcnt[aidx]
+        rfresh.next = fpub[count_addr]
 
     @always_comb
     def cread():
-        if wfresh:
-            cur.next = cmem[waddr]
-        else:
-            cur.next = 0
         if rfresh:
             count_data.next = cmem[raddr]
         else:
             count_data.next = 0
+        if afresh_q:
+            cur.next = aread
+        else:
+            cur.next = 0
+
+    @always_seq(clk.posedge, reset=rst)
+    def cahead():
+        due.next = due_next
+        aread.next = cmem[aaddr]
+        # a list's end clears the bank that counts next (token: this one; last: the other)
+        afresh_q.next = afresh and not (token or last)
 
     @always(clk.posedge)
     def cwrite():
@@ -220,10 +266,7 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
             ovf.next = False
             tot0.next = 0
             tot1.next = 0
-            if bank:
-                fresh1.next = 0
-            else:
-                fresh0.next = 0
+            fcnt.next = 0
         elif last:
             # publish: the other bank becomes the counting one, cleared by its flags
             listed.next = 0
@@ -235,15 +278,10 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
             tot1.next = 0
             frame_done.next = True
             bank.next = not bank
-            if bank:
-                fresh0.next = 0
-            else:
-                fresh1.next = 0
+            fpub.next = fcnt
+            fcnt.next = 0
         elif hit:
-            if bank:
-                fresh1.next[cidx] = 1
-            else:
-                fresh0.next[cidx] = 1
+            fcnt.next[cidx] = 1
             if sink.cam:
                 tot1.next = tot1 + 1
             else:
@@ -281,6 +319,6 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
             else:
                 half.next = True
 
-    return [decode, block_position(clk, rst, sink, x, y, blk, width=width, height=height, blocks=(bxn, byn)),
-            caddr, cflags, cread, cwrite, entry, ends, lists, serial, halves,
+    return [decode, block_position(clk, rst, sink, x, y, blk, ahead, width=width, height=height, blocks=(bxn, byn)),
+            borders, caddr, cflags, cahead, cread, cwrite, entry, ends, lists, serial, halves,
             sync_fifo(clk, rst, din, push, dout, pop, fcount, fvalid, depth=depth)]

@@ -22,7 +22,7 @@ from eyestereo.hdl.common.checks import (block_error, check_choice, check_clock,
 
 def latency(nms: int) -> tuple[int, int]:
     """(clocks, window lead r): flag (x, y) comes that many clocks after input pixel (x + r, y + r)."""
-    nms_lat = 1 if nms == 1 else nms + 2
+    nms_lat = 1 if nms == 1 else nms + 3
     return SOBEL_LATENCY + WINDOW_LATENCY + CORNER_LATENCY + 1 + nms_lat, radius(nms)
 
 
@@ -50,8 +50,8 @@ def harris_mono(clk, rst, sink, source, k, thr_we, thr_addr, thr_data, *, width:
         blocks: (BX, BY) threshold blocks, default (4, 4): 88x72-pixel blocks at 352x288.
         nms: 1, 3 or 5: non-maximum suppression window.
 
-    Latency: :func:`latency` -- nms 3: 4 lines + 4 pixels + 25 clocks; nms 5: 5 lines + 5 pixels +
-    27 clocks; nms 1: 3 lines + 3 pixels + 21 clocks.
+    Latency: :func:`latency` -- nms 3: 4 lines + 4 pixels + 29 clocks; nms 5: 5 lines + 5 pixels +
+    31 clocks; nms 1: 3 lines + 3 pixels + 24 clocks.
 
     Resources: 6 (nms 1) to 10 (nms 5) RAMB16, 7 multipliers (3 window, 4 cornerness); see docs/benchmarks.md.
     """

@@ -75,7 +75,7 @@ def harris_stereo(clk, rst, sink, source, k_left, k_right, thr_we, thr_cam, thr_
 
     Latency: :func:`latency`: flag (x, y) comes a constant number of clocks after the camera's input
     pixel (x + 3 + p, y + 3 + l) (nms 3: l = 1, p = 2; nms 1: 0, 0; nms 5: 2, 2); share 3, nms 3:
-    4 lines + 5 pixels of the camera (2 (4 width + 5) beats) + 25 clocks (measured by the benches).
+    4 lines + 5 pixels of the camera (2 (4 width + 5) beats) + 28 clocks (measured by the benches).
 
     Resources: stereo line delays: 2 Sobel (1 RAMB16 each), 4 window (2 each), 1 NMS 3x3 (2) -- 12
     RAMB16 at 352 wide for nms 3; :func:`multipliers` MULT18X18. Measured (make synth's flow, Yosys

@@ -3,19 +3,20 @@ Fig. 6.15)."""
 
 from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv
 
-from eyestereo.hdl.common import delay, delay_rst, en_reg, range_signal, shift_add
+from eyestereo.hdl.common import delay, delay_rst, en_reg, range_signal, shift_add, signal_range
+from eyestereo.hdl.common.arith import chain_sum
 from eyestereo.hdl.common.checks import check_clock, check_distinct, check_frame, check_reset, check_stream
 from eyestereo.hdl.common.fixed import fx_signal
 from eyestereo.hdl.common.packed import pack_word, unpack_word
 from eyestereo.hdl.interfaces.stream import ImageStream
-from eyestereo.hdl.streaming.window import check_share, column_taps, window_control, window_row
+from eyestereo.hdl.streaming.window import check_share, column_taps, tap_latency, window_control, window_row
 from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 from eyestereo.tools.fixed import sfix
 from eyestereo.tools.models import harris_window as model
 from eyestereo.tools.models import sobel as sobel_model
 
 N = 5
-LATENCY = 8  # mono: 1 product stage + the window's N + 2
+LATENCY = 10  # mono: 2 product stages + the window's tap_latency(N) + 3
 
 
 def multipliers(share: int = 1) -> int:
@@ -24,15 +25,15 @@ def multipliers(share: int = 1) -> int:
 
 
 def product_latency(share: int = 1, *, stereo: bool = False) -> int:
-    """Clocks from a Sobel beat to its product word: mono 1; stereo 1 operand register + one clock per
-    phase."""
-    return 1 + -(-3 // multipliers(share)) if stereo else 1
+    """Clocks from a Sobel beat to its product word: mono 2 (product register, rounding and clamps);
+    stereo 2 + one clock per phase (operand register, one product register per phase, rounding)."""
+    return 2 + -(-3 // multipliers(share)) if stereo else 2
 
 
 def latency(share: int = 1, *, stereo: bool = False) -> int:
-    """Clocks from the (camera's) input pixel (x + 2, y + 2) to output pixel (x, y): mono 8 (:data:`LATENCY`);
-    stereo 9, 10, 11 for share 1, 2, 3."""
-    return product_latency(share, stereo=stereo) + N + 2
+    """Clocks from the (camera's) input pixel (x + 2, y + 2) to output pixel (x, y): mono 10
+    (:data:`LATENCY`); stereo 11, 12, 13 for share 1, 2, 3."""
+    return product_latency(share, stereo=stereo) + tap_latency(N) + 3
 
 
 @block
@@ -66,8 +67,9 @@ def harris_window(clk, rst, sink, source, *, width: int = FRAME_WIDTH, height: i
         share: stereo streams only (1 for a mono one, else a ValueError): 1, 2 or 3 clocks per beat the
             product multipliers are shared over.
 
-    Latency: 8 clocks after input pixel (x + 2, y + 2): 2 lines + 2 pixels + 8 clocks. Stereo:
-    :func:`latency` clocks (9, 10, 11 for share 1, 2, 3) after the camera's input pixel (x + 2, y + 2).
+    Latency: 10 clocks after input pixel (x + 2, y + 2): 2 lines + 2 pixels + 10 clocks (the products 2,
+    the column taps 5, the vertical sums 1, the window row 1, the output register 1). Stereo:
+    :func:`latency` clocks (11, 12, 13 for share 1, 2, 3) after the camera's input pixel (x + 2, y + 2).
 
     Resources: 3 multipliers (10x10; stereo :func:`multipliers`: 3 / 2 / 1), 4 line delays of 36 bits
     (4 RAMB16; stereo 8 RAMB16 at width 352), adders and registers.
@@ -87,7 +89,8 @@ def harris_window(clk, rst, sink, source, *, width: int = FRAME_WIDTH, height: i
         mx = fx_signal(sfix(10))  # 2 Ix + 1
         my = fx_signal(sfix(10))
         big = 511 * 511
-        fxx, fyy, fxy = range_signal(0, big + 16), range_signal(0, big + 16), range_signal(-big + 16, big + 16)
+        fxx, fyy, fxy = range_signal(0, big), range_signal(0, big), range_signal(-big, big)
+        cxx, cyy, cxy = cut_signal(), cut_signal(), cut_signal()
         qxx, qyy = fx_signal(model.PROD_SQ), fx_signal(model.PROD_SQ)
         qxy = fx_signal(model.PROD_XY)
         sq_top = model.PROD_SQ.hi
@@ -102,30 +105,31 @@ def harris_window(clk, rst, sink, source, *, width: int = FRAME_WIDTH, height: i
             mx.next = concat(sink.data[xh:xl], True)
             my.next = concat(sink.data[yh:yl], True)
 
-        # The +16 rounds the cut by 32 below; it rides on the multiplier's output adder.
-        @always_comb
+        # The multipliers read the sink's register (the Sobel's output register) and write their own: a
+        # multiplier with the rounding and the clamps behind it would not fit a 110 MHz clock.
+        @always(clk.posedge)
         def multiply():
-            fxx.next = mx * mx + 16
-            fyy.next = my * my + 16
-            fxy.next = mx * my + 16
+            fxx.next = mx * mx
+            fyy.next = my * my
+            fxy.next = mx * my
 
         # Only inputs outside the Sobel's range can reach the clamps.
         @always_comb
         def saturate():
-            if (fxx >> 5) > sq_top:
+            if cxx > sq_top:
                 qxx.next = sq_top
             else:
-                qxx.next = fxx >> 5
-            if (fyy >> 5) > sq_top:
+                qxx.next = cxx
+            if cyy > sq_top:
                 qyy.next = sq_top
             else:
-                qyy.next = fyy >> 5
-            if (fxy >> 5) > xy_hi:
+                qyy.next = cyy
+            if cxy > xy_hi:
                 qxy.next = xy_hi
-            elif (fxy >> 5) < xy_lo:
+            elif cxy < xy_lo:
                 qxy.next = xy_lo
             else:
-                qxy.next = fxy >> 5
+                qxy.next = cxy
 
         prod = ImageStream(model.PRODUCTS)
         prod_word = Signal(intbv(0)[model.PRODUCTS.width:])
@@ -134,18 +138,16 @@ def harris_window(clk, rst, sink, source, *, width: int = FRAME_WIDTH, height: i
         def pack():
             prod.data.next = prod_word
 
-        @always_seq(clk.posedge, reset=rst)
-        def flags():
-            prod.valid.next = sink.valid
-            prod.eol.next = sink.eol
-            prod.eof.next = sink.eof
-
-        insts = [fields, multiply, saturate, pack_word(prod_word, model.PRODUCTS, pxx=qxx, pyy=qyy, pxy=qxy), pack,
-                 flags]
+        insts = [fields, multiply, rounding(fxx, cxx), rounding(fyy, cyy), rounding(fxy, cxy), saturate,
+                 pack_word(prod_word, model.PRODUCTS, pxx=qxx, pyy=qyy, pxy=qxy), pack]
+        for s, d in ((sink.valid, prod.valid), (sink.eol, prod.eol), (sink.eof, prod.eof)):
+            insts.append(delay_rst(clk, rst, s, d, clocks=product_latency()))
 
     taps = [Signal(intbv(0)[model.PACK_BITS:]) for _ in range(N)]
     tap_valid = Signal(bool(0))
-    insts.append(column_taps(clk, rst, prod, taps, tap_valid, width=width, height=height))
+    # Skewed taps and a chain of adders: the 36-bit words do not wait for the oldest row, the partial
+    # sums do (fewer registers; the vertical sums come tap_latency(N) + 1 clocks after the beat either way).
+    insts.append(column_taps(clk, rst, prod, taps, tap_valid, width=width, height=height, skew=True))
 
     weights = [int(w) for w in model.TAPS]
     col_valid = Signal(bool(0))
@@ -158,8 +160,8 @@ def harris_window(clk, rst, sink, source, *, width: int = FRAME_WIDTH, height: i
             insts.append(unpack_word(tap, model.PRODUCTS, **{product.name: f}))
         vlo = fmt.lo * sum(weights)
         vhi = fmt.hi * sum(weights)
-        vsum, vreg = range_signal(vlo, vhi), range_signal(vlo, vhi)
-        insts += [shift_add(list(zip(fields_i, weights)), vsum), delay(clk, vsum, vreg, clocks=1)]
+        vreg = range_signal(vlo, vhi)
+        insts.append(chain_sum(clk, list(zip(fields_i, weights))[::-1], vreg))  # the newest row first
         links, row = window_row(vreg, N, stereo=sink.stereo)
         for src, reg in links:
             insts.append(en_reg(clk, col_valid, src, reg))
@@ -174,8 +176,8 @@ def harris_window(clk, rst, sink, source, *, width: int = FRAME_WIDTH, height: i
         source.data.next = out_word
 
     insts += [pack_word(out_word, model.WORD, sxx=sxx, syy=syy, sxy=sxy), outreg,
-              window_control(clk, rst, prod, source, width=width, height=height, radius=N // 2, latency=N + 2,
-                             share=share)]
+              window_control(clk, rst, prod, source, width=width, height=height, radius=N // 2,
+                             latency=tap_latency(N) + 3, share=share)]
     return insts
 
 
@@ -184,114 +186,157 @@ def stereo_products(clk, rst, sink, prod, *, share: int):
     """:func:`harris_window`'s product stage for stereo streams: ``prod`` = the product word of each beat
     of ``sink`` (beats at least ``share`` clocks apart), :func:`product_latency` clocks later.
 
-    The operands 2c + 1 are registered; ``3 / share`` multipliers (rounded up) form the three products
-    over as many clocks as they need (thesis Fig. 6.15: share 3 uses one).
+    ``3 / share`` multipliers (rounded up) form the three products over as many clocks (phases) as they
+    need (thesis Fig. 6.15: share 3 uses one). Each multiplier is registered on both sides: its operands
+    2c + 1 come from registers loaded with the phase's pair (the sink's fields at the beat, the held
+    copies after it), its product goes into a register; the rounding cut of the next clock writes the
+    phase's field of the product word.
     """
     m = multipliers(share)
+    phases = -(-3 // m)
     lp = product_latency(share, stereo=True)
 
-    opx = fx_signal(sfix(10))  # 2 Ix + 1, held for the phases
-    opy = fx_signal(sfix(10))
     xh, xl = sobel_model.WORD.bits("ix")
     yh, yl = sobel_model.WORD.bits("iy")
+    sx = fx_signal(sfix(10))  # 2 Ix + 1 of the sink's beat
+    sy = fx_signal(sfix(10))
+    opx = fx_signal(sfix(10))  # the same, held for the later phases
+    opy = fx_signal(sfix(10))
+
+    @always_comb
+    def fields():
+        sx.next = concat(sink.data[xh:xl], True)
+        sy.next = concat(sink.data[yh:yl], True)
 
     @always(clk.posedge)
-    def operands():
+    def hold():
         if sink.valid:
-            opx.next = concat(sink.data[xh:xl], True)
-            opy.next = concat(sink.data[yh:yl], True)
+            opx.next = sx
+            opy.next = sy
 
-    # Phase flags: the beat's valid 1, 2, 3 clocks later (beats come at least share clocks apart, so at
-    # most one is high at a time).
-    ph = [Signal(bool(0)) for _ in range(3)]
+    # Phase flags: the beat's valid 1 .. phases + 1 clocks later (beats come at least share clocks apart,
+    # so at most one is high at a time). Phase j's operands are in their registers while ph[j - 1] is
+    # high (ph[-1]: the beat itself), its product while ph[j] is high.
+    ph = [Signal(bool(0)) for _ in range(phases + 1)]
 
     @always_seq(clk.posedge, reset=rst)
-    def phases():
+    def phase_flags():
         ph[0].next = sink.valid
-        ph[1].next = ph[0]
-        ph[2].next = ph[1]
+        for j in range(1, phases + 1):
+            ph[j].next = ph[j - 1]
 
     big = 511 * 511
     qxx, qyy = fx_signal(model.PROD_SQ), fx_signal(model.PROD_SQ)
     qxy = fx_signal(model.PROD_XY)
-    insts = [operands, phases]
-    p0, p1, p2 = ph
+    insts = [fields, hold, phase_flags]
     if m == 3:
-        fxx, fyy, fxy = range_signal(0, big + 16), range_signal(0, big + 16), range_signal(-big + 16, big + 16)
+        # The held operands are the multipliers' input registers; one phase.
+        fxx, fyy, fxy = range_signal(0, big), range_signal(0, big), range_signal(-big, big)
 
-        @always_comb
+        @always(clk.posedge)
         def multiply():
-            fxx.next = opx * opx + 16
-            fyy.next = opy * opy + 16
-            fxy.next = opx * opy + 16
+            fxx.next = opx * opx
+            fyy.next = opy * opy
+            fxy.next = opx * opy
+
+        sxx, syy, sxy = cut_signal(), cut_signal(), cut_signal()
 
         @always(clk.posedge)
         def cut():
-            qxx.next = fxx >> 5
-            qyy.next = fyy >> 5
-            qxy.next = fxy >> 5
+            qxx.next = sxx
+            qyy.next = syy
+            qxy.next = sxy
 
-        insts += [multiply, cut]
+        insts += [multiply, rounding(fxx, sxx), rounding(fyy, syy), rounding(fxy, sxy), cut]
     elif m == 2:
+        # Multiplier 0: x * x, then x * y (the operand register b0 takes x at the beat, y after it);
+        # multiplier 1: y * y on the held operand.
         b0 = fx_signal(sfix(10))
-        f0, f1 = range_signal(-big + 16, big + 16), range_signal(0, big + 16)
-        s0 = range_signal((-big + 16) >> 5, (big + 16) >> 5)
+        f0, f1 = range_signal(-big, big), range_signal(0, big)
+        p0, p1, p2 = ph
 
-        @always_comb
-        def choose_operands():
-            if p1:
+        @always(clk.posedge)
+        def operands():
+            if sink.valid:
+                b0.next = sx
+            elif p0:
                 b0.next = opy
-            else:
-                b0.next = opx
 
-        @always_comb
+        @always(clk.posedge)
         def multiply():
-            f0.next = opx * b0 + 16
-            f1.next = opy * opy + 16
-            s0.next = f0 >> 5
+            f0.next = opx * b0
+            f1.next = opy * opy
+
+        s0, s1 = cut_signal(), cut_signal()
 
         @always(clk.posedge)
         def cut():
-            if p0:
+            if p1:
                 qxx.next = s0
-                qyy.next = f1 >> 5
-            if p1:
-                qxy.next = s0
-
-        insts += [choose_operands, multiply, cut]
-    else:
-        a0, b0 = fx_signal(sfix(10)), fx_signal(sfix(10))
-        f0 = range_signal(-big + 16, big + 16)
-        s0 = range_signal((-big + 16) >> 5, (big + 16) >> 5)
-
-        @always_comb
-        def choose_operands():
-            if p1:
-                a0.next = opy
-            else:
-                a0.next = opx
-            if p0:
-                b0.next = opx
-            else:
-                b0.next = opy
-
-        @always_comb
-        def multiply():
-            f0.next = a0 * b0 + 16
-            s0.next = f0 >> 5
-
-        @always(clk.posedge)
-        def cut():
-            if p0:
-                qxx.next = s0
-            if p1:
-                qyy.next = s0
+                qyy.next = s1
             if p2:
                 qxy.next = s0
 
-        insts += [choose_operands, multiply, cut]
+        insts += [operands, multiply, rounding(f0, s0), rounding(f1, s1), cut]
+    else:
+        # One multiplier: x * x, y * y, x * y in turn.
+        a0, b0 = fx_signal(sfix(10)), fx_signal(sfix(10))
+        f0 = range_signal(-big, big)
+        p0, p1, p2, p3 = ph
+
+        @always(clk.posedge)
+        def operands():
+            if sink.valid:
+                a0.next = sx
+                b0.next = sx
+            elif p0:
+                a0.next = opy
+                b0.next = opy
+            elif p1:
+                a0.next = opx
+                b0.next = opy
+
+        @always(clk.posedge)
+        def multiply():
+            f0.next = a0 * b0
+
+        s0 = cut_signal()
+
+        @always(clk.posedge)
+        def cut():
+            if p1:
+                qxx.next = s0
+            if p2:
+                qyy.next = s0
+            if p3:
+                qxy.next = s0
+
+        insts += [operands, multiply, rounding(f0, s0), cut]
 
     insts.append(pack_word(prod.data, model.PRODUCTS, pxx=qxx, pyy=qyy, pxy=qxy))
     for s, d in ((sink.valid, prod.valid), (sink.eol, prod.eol), (sink.eof, prod.eof), (sink.cam, prod.cam)):
         insts.append(delay_rst(clk, rst, s, d, clocks=lp))
     return insts
+
+
+def cut_signal():
+    """A product of two 2c + 1 operands rounded and cut by 32 (:func:`rounding`'s output)."""
+    big = 511 * 511
+    return range_signal((-big + 16) >> 5, (big + 16) >> 5)
+
+
+@block
+def rounding(f, out):
+    """Combinational ``out = (f + 16) >> 5``: a product rounded to its field's unit (1/32)."""
+    lo, hi = signal_range(f)
+    r = range_signal(lo + 16, hi + 16)
+
+    @always_comb
+    def add():
+        r.next = f + 16
+
+    @always_comb
+    def cut():
+        out.next = r >> 5
+
+    return add, cut

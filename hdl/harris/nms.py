@@ -8,7 +8,7 @@ from eyestereo.hdl.common.fixed import fx_signal
 from eyestereo.hdl.common.registers import assign, delay, en_reg
 from eyestereo.hdl.interfaces.stream import ImageStream
 from eyestereo.hdl.streaming.line_delay import line_delay
-from eyestereo.hdl.streaming.window import check_share, column_taps, window_control, window_row
+from eyestereo.hdl.streaming.window import check_share, column_taps, tap_latency, window_control, window_row
 from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH, NMS_DEFAULT, NMS_SIZES
 from eyestereo.tools.models import cornerness as corner_model
 
@@ -16,7 +16,7 @@ from eyestereo.tools.models import cornerness as corner_model
 def stereo_latency(size: int) -> int:
     """Stereo streams: clocks from the input beat that completes a flag's window to the flag (see
     :func:`stereo_lead`)."""
-    return {1: 1, 3: 3, 5: 7}[size]
+    return {1: 1, 3: 3, 5: 8}[size]
 
 
 def stereo_lead(size: int) -> tuple[int, int]:
@@ -56,9 +56,10 @@ def nms(clk, rst, sink, source, *, width: int = FRAME_WIDTH, height: int = FRAME
             ``share`` clocks (the Harris chain's beat spacing). A mono stream has no tail spacing: any
             share but 1 is refused there.
 
-    Latency: mono: size 1: 1 clock; size N = 3, 5: N + 2 clocks after input pixel (x + r, y + r),
-    r = N // 2. Stereo: :func:`stereo_latency` clocks after the camera's input pixel :func:`stereo_lead`
-    (size 1: the pixel itself, 1 clock; 3: (x + 2, y + 1), 3 clocks; 5: (x + 2, y + 2), 7 clocks).
+    Latency: mono: size 1: 1 clock; size N = 3, 5: N + 3 clocks after input pixel (x + r, y + r),
+    r = N // 2 (the column taps N, the vertical pass 1, the window row 1, the output register 1). Stereo:
+    :func:`stereo_latency` clocks after the camera's input pixel :func:`stereo_lead` (size 1: the pixel
+    itself, 1 clock; 3: (x + 2, y + 1), 3 clocks; 5: (x + 2, y + 2), 8 clocks).
 
     Resources: mono: N - 1 line delays of 20 bits (one RAMB16 each), 3N registers of 20 bits, 3N - 1
     comparators. Stereo: size 3: one stereo line delay of 20 bits (2 RAMB16 at width 352); size 5:
@@ -144,7 +145,7 @@ def nms(clk, rst, sink, source, *, width: int = FRAME_WIDTH, height: int = FRAME
         source.data.next = result
 
     insts += [outreg, window_control(clk, rst, sink, source, width=width, height=height, radius=r,
-                                     latency=size + 2, share=share)]
+                                     latency=tap_latency(size) + 3, share=share)]
     return insts
 
 

@@ -19,13 +19,17 @@ def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: i
     Block (bx, by) covers columns [bx*W//BX, (bx+1)*W//BX) and rows [by*H//BY, (by+1)*H//BY); its index
     is by*BX + bx (:func:`~eyestereo.hdl.harris.block_position.block_position` follows it). The
     thresholds sit in a small distributed RAM (one LUT per bit for up to 16 blocks) plus one "written"
-    flag per entry; the flags clear on ``rst``, so every threshold reads 0 after a reset. A write takes
-    effect from the next clock: write between frames for a consistent frame.
+    flag per entry; the flags clear on ``rst``, so every threshold reads 0 after a reset. The table is
+    read one clock ahead, at the block of the beat due next (the block position's ``ahead``), into a
+    register, so that the comparison starts from registers only. A write therefore takes effect from the
+    second clock after it (the next clock for blocks (1, 1)): write between frames for a consistent frame.
 
     The camera count comes from the stream. On a stereo stream (left and right beat of each pixel in
     turn, ``cam`` forwarded) each camera has its own thresholds: the table has an entry per block and
     camera, addressed 2 * block + cam (as ``feature_list``'s counts), and one block position serves
-    both cameras.
+    both cameras. The camera of the beat due next is the one after the last beat's (left after a right
+    beat or a reset token), so a beat that breaks the left-right order (two of one camera in turn) is
+    compared with the other camera's threshold.
 
     Ports:
         clk, rst: clock and synchronous active-high reset.
@@ -45,8 +49,8 @@ def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: i
     Latency: 1 clock.
 
     Resources: BX*BY x 20 bits of LUT-RAM (stereo: a table of 2^(ceil(log2(BX BY)) + 1) entries), a flag
-    register per entry, the block position counters, one comparator; (1, 1): one threshold register per
-    camera and no counters.
+    register per entry, the threshold register, the block position counters, one comparator; (1, 1): one
+    threshold register per camera and no counters.
     """
     nb = corner_model.OUT.wl
     check_clock(clk)
@@ -74,22 +78,34 @@ def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: i
     x = Signal(intbv(0, min=0, max=width))
     y = Signal(intbv(0, min=0, max=height))
     blk = Signal(intbv(0, min=0, max=nblk))
+    ahead = Signal(intbv(0, min=0, max=nblk))  # the block of the beat due next
     stored = Signal(intbv(0)[nb:])
-    thr = fx_signal(corner_model.OUT)
+    thr = fx_signal(corner_model.OUT)  # the threshold of the beat due, registered
     value = fx_signal(corner_model.OUT)
     insts = []
     if sink.stereo:
-        # The table is addressed by (block, cam): the camera is the address's low bit.
+        # The table is addressed by (block, cam): the camera is the address's low bit. The beat due next is
+        # the right camera's after a left beat, else the left camera's.
         entries = 1 << (abits + 1)
         raddr = Signal(intbv(0)[abits + 1:])
+        due = Signal(bool(0))  # the camera of the beat due now
+        due_next = Signal(bool(0))
 
         @always_comb
         def address():
-            raddr.next = concat(blk, sink.cam)
+            if sink.valid:
+                due_next.next = not sink.cam and not (sink.eof and not sink.eol)
+            else:
+                due_next.next = due
+            raddr.next = concat(ahead, due_next)
 
-        insts.append(address)
+        @always_seq(clk.posedge, reset=rst)
+        def camera():
+            due.next = due_next
+
+        insts += [address, camera]
     else:
-        entries, raddr = nblk, blk
+        entries, raddr = nblk, ahead
     mem = [Signal(intbv(0)[nb:]) for _ in range(entries)]
     written = Signal(intbv(0)[entries:])
 
@@ -121,16 +137,19 @@ def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: i
     def read():
         stored.next = mem[raddr]
 
-    @always_comb
-    def choose():
-        value.next = sink.data
+    @always_seq(clk.posedge, reset=rst)
+    def fetch():
         if written[raddr]:
             thr.next = stored
         else:
             thr.next = 0
 
-    return insts + [write_check, ram, flags, read, choose,
-                    block_position(clk, rst, sink, x, y, blk, width=width, height=height, blocks=blocks),
+    @always_comb
+    def signed_view():
+        value.next = sink.data
+
+    return insts + [write_check, ram, flags, read, fetch, signed_view,
+                    block_position(clk, rst, sink, x, y, blk, ahead, width=width, height=height, blocks=blocks),
                     pass_greater(clk, rst, sink, source, value, thr)]
 
 
@@ -186,16 +205,21 @@ def pass_greater(clk, rst, sink, source, value, thr):
         source.valid.next = sink.valid
         source.eol.next = sink.eol
         source.eof.next = sink.eof
+
+    # The data register has no reset (its value counts only with valid): the comparison alone clears it, as
+    # the flip-flops' synchronous reset, with no gate before.
+    @always(clk.posedge)
+    def data():
         if value > thr:
             source.data.next = sink.data
         else:
             source.data.next = 0
 
     if not sink.stereo:
-        return emit
+        return emit, data
 
     @always_seq(clk.posedge, reset=rst)
     def camera():
         source.cam.next = sink.cam
 
-    return emit, camera
+    return emit, data, camera

@@ -11,7 +11,7 @@ from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 from eyestereo.tools.fixed import shift_between
 from eyestereo.tools.models.sobel import GRAD, OUT, WORD
 
-LATENCY = 5
+LATENCY = 6  # the column taps 3, the vertical pass 1, the window row 1, the output register 1
 
 
 @block
@@ -40,8 +40,8 @@ def sobel(clk, rst, sink, source, *, width: int = FRAME_WIDTH, height: int = FRA
         share: stereo streams only (1 for a mono one, else a ValueError): the tail after each frame is
             emitted one beat every ``share`` clocks (1, 2 or 3), the spacing ``harris_stereo`` keeps.
 
-    Latency: 5 clocks after the (camera's) input pixel (x + 1, y + 1): 1 line + 1 pixel + 5 clocks
-    (stereo: 2 width + 2 beats + 5 clocks).
+    Latency: 6 clocks after the (camera's) input pixel (x + 1, y + 1): 1 line + 1 pixel + 6 clocks
+    (stereo: 2 width + 2 beats + 6 clocks).
 
     Resources: 2 line delays (mono: 2 RAMB16 for width <= 2048; stereo: 2 RAMB16 for width <= 1024),
     shift-and-add logic, no multipliers.

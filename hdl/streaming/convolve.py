@@ -7,7 +7,7 @@ from eyestereo.hdl.common import delay, en_reg, range_signal, shift_add, signal_
 from eyestereo.hdl.common.checks import (block_error, check_clock, check_distinct, check_frame, check_int,
                                          check_reset, check_stream, checked)
 from eyestereo.hdl.common.fixed import fx_signal
-from eyestereo.hdl.streaming.window import column_taps, window_control, window_row
+from eyestereo.hdl.streaming.window import column_taps, tap_latency, window_control, window_row
 from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 from eyestereo.tools.models.convolve import check_kernel, output_format
 
@@ -35,7 +35,8 @@ def convolve(clk, rst, sink, source, *, kernel=None, col=None, row=None, shift: 
         shift: right shift (floor) applied to the sum, >= 0.
         width, height: frame size, each at least N.
 
-    Latency: N + 2 clocks after input pixel (x + r, y + r), i.e. r lines + r pixels + N + 2 clocks.
+    Latency: N + 3 clocks after input pixel (x + r, y + r), i.e. r lines + r pixels + N + 3 clocks (the
+    column taps N, the vertical sums or the row sums 1, the window row 1, the output register 1).
 
     Resources: N - 1 line delays (one RAMB16 each for width x data bits up to 512x36), adders and
     registers; no multipliers.
@@ -102,7 +103,7 @@ def convolve(clk, rst, sink, source, *, kernel=None, col=None, row=None, shift: 
         source.data.next = scaled[bits:]
 
     insts += [scale, outreg,
-              window_control(clk, rst, sink, source, width=width, height=height, radius=r, latency=n + 2)]
+              window_control(clk, rst, sink, source, width=width, height=height, radius=r, latency=tap_latency(n) + 3)]
     return insts
 
 

@@ -45,13 +45,24 @@ def check_share(share, sink) -> int:
 
 
 @block
-def column_taps(clk, rst, sink, taps, tap_valid, *, width: int, height: int):
+def column_taps(clk, rst, sink, taps, tap_valid, *, width: int, height: int, skew: bool = False):
     """N pixels of one column, rows y-r (``taps[0]``) .. y+r (``taps[-1]``), aligned to one clock.
 
     ``taps[-1]`` is the newest pixel (the sink's), ``taps[0]`` the one N-1 lines earlier. The taps and
-    ``tap_valid`` (a pixel beat, not a reset token) are registered N-1 clocks after the sink beat. On a
-    stereo ``sink`` all taps come from the beat's own camera (the stereo line delays keep the cameras
-    apart).
+    ``tap_valid`` (a pixel beat, not a reset token) are registered :func:`tap_latency` (N) clocks after
+    the sink beat. On a stereo ``sink`` all taps come from the beat's own camera (the stereo line delays
+    keep the cameras apart).
+
+    ``skew=True``: the taps are not aligned; the one k lines old (``taps[-1 - k]``) is registered k + 1
+    clocks after the sink beat (one register each), ``tap_valid`` still N clocks after it, with the
+    oldest. For a weighted column sum that adds one tap per clock
+    (:func:`~eyestereo.hdl.common.arith.chain_sum`): its partial sums wait instead of the taps.
+
+    Every block RAM read is registered once before anything else sees it (the role of the RAM's output
+    register, which the ECP5 mapping does not use): a block RAM's clock-to-output takes most of a
+    100 MHz clock on its own, so an adder or comparator behind it cannot meet 110 MHz. The line delays
+    are chained from the RAM outputs themselves (RAM to RAM, no logic), so the chain stays one clock per
+    line delay and the alignment costs one register per tap more than without the output registers.
     """
     check_clock(clk)
     check_reset(rst)
@@ -70,13 +81,10 @@ def column_taps(clk, rst, sink, taps, tap_valid, *, width: int, height: int):
         s = ImageStream(dw, stereo=sink.stereo)
         insts.append(line_delay(clk, rst, streams[-1], s, width=width, height=height))
         streams.append(s)
-    # streams[k] is k lines old and k clocks late; bring them all to n-1 clocks.
+    # streams[k] is k lines old and k clocks late; bring them all to n clocks (so the oldest, a RAM
+    # output, passes one register: the output register).
     for k, s in enumerate(streams):
-        tap = taps[n - 1 - k]
-        if k == n - 1:
-            insts.append(assign(s.data, tap))
-        else:
-            insts.append(delay(clk, s.data, tap, clocks=n - 1 - k))
+        insts.append(delay(clk, s.data, taps[n - 1 - k], clocks=1 if skew else tap_latency(n) - k))
     pix = Signal(bool(0))
 
     @always_comb
@@ -84,8 +92,14 @@ def column_taps(clk, rst, sink, taps, tap_valid, *, width: int, height: int):
         pix.next = sink.valid and (sink.eol or not sink.eof)
 
     insts.append(decode)
-    insts.append(delay(clk, pix, tap_valid, clocks=n - 1))
+    insts.append(delay(clk, pix, tap_valid, clocks=tap_latency(n)))
     return insts
+
+
+def tap_latency(n: int) -> int:
+    """Clocks from a sink beat to its :func:`column_taps` of ``n`` rows: n - 1 line delays of one clock
+    each and the register behind the last one's block RAM."""
+    return n
 
 
 def row_regs(first, n: int, *, stereo: bool) -> list:

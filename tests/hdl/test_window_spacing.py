@@ -11,11 +11,11 @@ from eyestereo.sim.lib.runner import run_bench
 
 pytestmark = pytest.mark.sim
 
-# block, parameters, the clocks from a sink beat to its source beat (the docstrings' latencies: sobel 5,
-# harris_window stereo with share 2: 10), the lead in pixels of a camera (r * width + r)
-CASES = [("sobel", dict(width=3, height=3, share=2), 5, 4),
-         ("sobel", dict(width=4, height=3, share=3), 5, 5),
-         ("harris_window", dict(width=5, height=5, share=2), 10, 12)]
+# block, parameters, the clocks from a sink beat to its source beat (the docstrings' latencies: sobel 6,
+# harris_window stereo with share 2: 12), the lead in pixels of a camera (r * width + r)
+CASES = [("sobel", dict(width=3, height=3, share=2), 6, 4),
+         ("sobel", dict(width=4, height=3, share=3), 6, 5),
+         ("harris_window", dict(width=5, height=5, share=2), 12, 12)]
 
 
 @pytest.mark.parametrize("block,params,latency,lead", CASES, ids=lambda v: str(v) if not isinstance(v, dict)
@@ -30,6 +30,6 @@ def test_tokens_keep_the_spacing(request, block, params, latency, lead):
 @pytest.mark.parametrize("sim", ["icarus", "verilator"])
 def test_tokens_keep_the_spacing_verilog(request, sim):
     """The same on MyHDL's Verilog conversion (sobel 3x3, share 2)."""
-    report = run_bench("sobel", "tb_window_spacing", dict(latency=5, lead=4), name=request.node.name, sim=sim,
+    report = run_bench("sobel", "tb_window_spacing", dict(latency=6, lead=4), name=request.node.name, sim=sim,
                        params=dict(width=3, height=3, share=2, stereo=True))
     assert report["tokens"] == 2 * 4 * 2 + 2 and report["min_gap"] >= 2
