@@ -496,8 +496,13 @@ JOBS = {j.name: j for j in [
         "every master granted (covers)",
         multiclock=False, mode="prove", depth=8, cover_depth=16, mutant_depth=10,
         mutants=(("cam0 granted with cam1's accesses too (two masters in one clock)",
-                  "g[i] = (iss && ($signed({1'b0, own}) == i));",
-                  "g[i] = (iss && (($signed({1'b0, own}) == i) || ((i == 0) && (own == 1))));"),)),
+                  "g[i] = (own1h[i] && reqv[i] && ok);",
+                  "g[i] = ((own1h[i] || ((i == 0) && own1h[1])) && reqv[i] && ok);"),
+                 ("cam0's lookahead keeps the buffer claim past the frame's last word (req after a granted eof "
+                  "ignores it)",
+                  "((frame_writer0_writer_issue0_claimed_n && (!frame_writer0_writer_issue0_eof)) || "
+                  "(!frame_writer0_writer_issue0_b_sof))",
+                  "(frame_writer0_writer_issue0_claimed_n || (!frame_writer0_writer_issue0_b_sof))"))),
     Job("sram_arbiter_wait", "sram_arbiter", _ARB, "sram_arbiter_wait_props.vh",
         "same environment: an urgent writer (cam0, cam1, rect) that asks moves a word (or drops one) within 12 "
         "clocks, whatever the others do (12 is tight: 11 fails)",

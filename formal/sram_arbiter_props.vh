@@ -61,6 +61,19 @@ always @(*) if (f_past && !rst) begin
     if (f_cmd_wait) assert(!f_issued && f_cmd == f_cmd_p);
     // a turn is owned by one master: the owner's turn length is within its burst
     if (own_v) assert(beats <= ((own == 3'd2) ? 3'd4 : (own == 3'd5) ? 3'd1 : 3'd2));
+    // the owner and the next owner are kept twice, binary and one-hot (the grant reads the one-hot copy)
+    assert(own1h == (own_v ? (6'd1 << own) : 6'd0));
+    assert(nxt1h == (nxt_v ? (6'd1 << nxt) : 6'd0));
+    // each writer's registered req (worked out a clock ahead for both answers of the arbiter) is its rule on
+    // the head entry: a word, not an abort, not of a dropped frame, its frame's buffer claimed (or not its first)
+    assert(frame_writer0_writer_issue0_head_req == (frame_writer0_writer_issue0_has && !frame_writer0_writer_issue0_abt
+        && !frame_writer0_writer_issue0_discard && (frame_writer0_writer_issue0_claimed || !frame_writer0_writer_issue0_sof)));
+    assert(frame_writer1_writer_issue1_head_req == (frame_writer1_writer_issue1_has && !frame_writer1_writer_issue1_abt
+        && !frame_writer1_writer_issue1_discard && (frame_writer1_writer_issue1_claimed || !frame_writer1_writer_issue1_sof)));
+    assert(frame_writer2_writer_issue2_head_req == (frame_writer2_writer_issue2_has && !frame_writer2_writer_issue2_abt
+        && !frame_writer2_writer_issue2_discard && (frame_writer2_writer_issue2_claimed || !frame_writer2_writer_issue2_sof)));
+    assert(frame_writer3_writer_issue3_head_req == (frame_writer3_writer_issue3_has && !frame_writer3_writer_issue3_abt
+        && !frame_writer3_writer_issue3_discard && (frame_writer3_writer_issue3_claimed || !frame_writer3_writer_issue3_sof)));
 end
 
 // ---- covers ------------------------------------------------------------------------------------------

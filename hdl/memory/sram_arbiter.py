@@ -100,8 +100,9 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     access, the other urgent writers' bursts and a bus turnaround, whatever the rest does, and every turn
     moves at least one word: no master starves (docs/sram.md measures the waits under overload). On a
     pipelined SyncBurst part the controller holds a write back during the turnaround; the turn is kept
-    meanwhile, so a stream of reads cannot starve a write. The owner, the next owner and the command to
-    the controller are registers: between flip-flops there are at most a few LUT levels.
+    meanwhile, so a stream of reads cannot starve a write. The owner (also kept one-hot), the next owner,
+    every master's ``req`` and the command to the controller are registers: a grant is two LUT levels
+    from flip-flops, and each engine's registers follow it within one or two more.
 
     Frame buffers (hdl/memory/frame_buffers.py): each writer has two buffers (address map:
     :class:`eyestereo.tools.models.sram_arbiter.AddressMap`) and a :func:`double_buffer` state; the system's
@@ -109,9 +110,10 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     by ``cam_want``/``cam_held``.
 
     Status port (``stat``): address -> 32-bit word, two clocks later: 0..5 words moved per master,
-    6..11 clocks each master waited (it asked or held a turn and was not granted), 12 clocks since
-    reset, 13..18 frames published / dropped / overwritten per double buffer, 19 buffer states and the
-    rectified writer's lost words, 20..21 the feature lists' word counts (``STAT`` in the model module).
+    6..11 clocks each master waited (it asked or held a turn and was not granted; these twelve count a
+    clock late, from registered copies of the grants and waits), 12 clocks since reset, 13..18 frames
+    published / dropped / overwritten per double buffer, 19 buffer states and the rectified writer's lost
+    words, 20..21 the feature lists' word counts (``STAT`` in the model module).
 
     Ports:
         clk, rst: clock (the SRAM's, 100 MHz) and synchronous active-high reset.
@@ -136,8 +138,8 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     first pixel comes 11 clocks after the request is taken, a host read's word 7 clocks after; each
     waits longer while other masters hold the bus.
 
-    Resources: see docs/sram.md (Yosys, Spartan-3E); with the defaults about 1360 LUTs, 77 LUT-RAM
-    (the writers' FIFOs), 1480 flip-flops (two thirds of them the 32-bit counters).
+    Resources: see docs/sram.md (Yosys, Spartan-3E); with the defaults about 1260 LUTs, 77 LUT-RAM
+    (the writers' FIFOs), 1510 flip-flops (two thirds of them the 32-bit counters).
     """
     width, height, feature_words, depth, burst, fetch_burst, host_burst, counter_bits, amap = check_masters(
         clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, width=width, height=height,
@@ -239,6 +241,9 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     # issues one access per clock while it has one, for up to its burst length; the *next* owner is
     # chosen one clock ahead (registered) from the masters' registered start/urgent flags, round robin
     # from the current owner. The command to the controller is registered too (``slot``).
+    # The grant is the shortest path of all (every engine updates on it): the owner is also kept one-hot
+    # (``own1h``, 0 without an owner), every engine's ``req`` is a register, and the controller's
+    # ``cmd.ready`` and ``preempt`` meet in one LUT (``rdy``), so ``gv[i] = own1h[i] and req[i] and rdy``.
     reqv = ConcatSignal(*(h.req for h in reversed(heads)))
     startv = ConcatSignal(*(h.start for h in reversed(heads)))
     urgv = ConcatSignal(*(h.urgent for h in reversed(heads)))
@@ -246,18 +251,23 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     maxb = max(bursts)
     own = Signal(intbv(NM - 1, min=0, max=NM))
     own_v = Signal(bool(0))
+    own1h = Signal(intbv(0)[NM:])  # one-hot of own while own_v, else 0
     own_urg = Signal(bool(0))
     beats = Signal(intbv(0, min=0, max=maxb + 1))
+    last_beat = Signal(bool(0))  # beats == 1
     nxt = Signal(intbv(0, min=0, max=NM))
+    nxt1h = Signal(intbv(0)[NM:])  # one-hot of nxt while nxt_v, else 0
     nxt_v = Signal(bool(0))
     nxt_urg = Signal(bool(0))
     preempt = Signal(bool(0))
     served = Signal(bool(0))  # the current turn has moved a word
     last1 = Signal(intbv(NM - 1, min=0, max=NM))  # the last non-urgent master to start a turn
     nxt_c = Signal(intbv(0, min=0, max=NM))
+    nxt1h_c = Signal(intbv(0)[NM:])
     nxt_vc = Signal(bool(0))
     nxt_urgc = Signal(bool(0))
     preempt_c = Signal(bool(0))
+    rdy = Signal(bool(0))
     issue = Signal(bool(0))
     turn_over = Signal(bool(0))
     blen = Signal(intbv(0, min=0, max=maxb + 1))
@@ -267,8 +277,8 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     above = Signal(intbv(0)[NM:])
     AFTER = tuple(((1 << NM) - 1) & ~((1 << (k + 1)) - 1) for k in range(NM))  # masters above k
     gv = Signal(intbv(0)[NM:])
-    wantv = Signal(intbv(0)[NM:])
     slot_v = Signal(bool(0))
+    slot_free = Signal(bool(0))
     slot = Signal(intbv(0)[ACCESS.width:])
 
     @always_comb
@@ -297,11 +307,17 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     def next_choice():
         # round robin: the lowest master above the current owner in the pool, else the lowest in it
         # (the owner itself comes last); the pool is the urgent masters if any, else all that ask
+        # (the owner also one-hot: h, 0 when none asks)
         k = NM - 1
+        h = intbv(0)[NM:]
+        h[NM - 1] = cand[NM - 1]
         for i in downrange(NM - 1):
             if cand[i]:
                 k = i
+                h[:] = 0
+                h[i] = 1
         nxt_c.next = k
+        nxt1h_c.next = h
         nxt_vc.next = cand != 0
         nxt_urgc.next = urg != 0
         # an urgent master ends a non-urgent turn, but only after that turn moved a word: every turn
@@ -310,14 +326,16 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
 
     @always_comb
     def issue_logic():
-        r = reqv[own]
-        iss = own_v and r and (not slot_v or cmd.ready) and not preempt
-        issue.next = iss
-        turn_over.next = not own_v or not r or preempt or (iss and beats == 1)
+        ok = (not slot_v or cmd.ready) and not preempt
+        rdy.next = ok
+        slot_free.next = not slot_v or cmd.ready
         g = intbv(0)[NM:]
         for i in range(NM):
-            g[i] = iss and own == i
+            g[i] = own1h[i] and reqv[i] and ok
         gv.next = g
+        iss = (own1h & reqv) != 0 and ok
+        issue.next = iss
+        turn_over.next = (own1h & reqv) == 0 or preempt or (iss and last_beat)
 
     @always_comb
     def burst_length():
@@ -326,19 +344,23 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     @always_seq(clk.posedge, reset=rst)
     def turn():
         nxt.next = nxt_c
+        nxt1h.next = nxt1h_c
         nxt_v.next = nxt_vc
         nxt_urg.next = nxt_urgc
         preempt.next = preempt_c and not turn_over
         if turn_over:
             own.next = nxt
             own_v.next = nxt_v
+            own1h.next = nxt1h
             own_urg.next = nxt_urg
             beats.next = blen
+            last_beat.next = blen == 1
             served.next = False
             if nxt_v and not nxt_urg:
                 last1.next = nxt
         elif issue:
             beats.next = beats - 1
+            last_beat.next = beats == 2
             served.next = True
         if issue:
             slot_v.next = True
@@ -346,12 +368,14 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
             slot_v.next = False
 
     # (one process, an if-elif chain on the owner: the cheapest multiplexer after synthesis; a tree of
-    # two-way multiplexers built in a loop costs LUTs, a list indexed by the owner an undefined netlist)
+    # two-way multiplexers built in a loop costs LUTs, a list indexed by the owner an undefined netlist.
+    # The slot takes the owner's access whenever it is free, issued or not: ``cmd.valid`` says whether it
+    # is a command, and the load enable does not wait for the grant.)
     a0, a1, a2, a3, a4, a5 = (h.access for h in heads)
 
     @always(clk.posedge)
     def slot_load():
-        if issue:
+        if slot_free:
             if own == 0:
                 slot.next = a0
             elif own == 1:
@@ -365,14 +389,7 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
             else:
                 slot.next = a5
 
-    @always_comb
-    def bookkeeping():
-        w = intbv(0)[NM:]
-        for i in range(NM):
-            w[i] = startv[i] or (own_v and own == i and reqv[i])
-        wantv.next = w
-
-    insts += [urgency, pools, masked, next_choice, issue_logic, burst_length, turn, slot_load, bookkeeping,
+    insts += [urgency, pools, masked, next_choice, issue_logic, burst_length, turn, slot_load,
               assign(slot_v, cmd.valid),
               unpack_word(slot, ACCESS, we=cmd.we, addr=cmd.addr, wdata=cmd.wdata, be=cmd.be, tag=cmd.tag)]
 
@@ -383,10 +400,13 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     waits = [Signal(intbv(0)[counter_bits:]) for _ in range(NM)]
     clocks = Signal(intbv(0)[counter_bits:])
     one = Signal(bool(1))
+    # the counters count registered grants and waits (a clock late: the grant's fan-out stays small)
+    gv_r, wait_r = Signal(intbv(0)[NM:]), Signal(intbv(0)[NM:])
+    insts.append(activity(clk, rst, gv, reqv, startv, own1h, gv_r, wait_r))
     for i, head in enumerate(heads):
-        waiting = Signal(bool(0))
-        insts.append(activity(gv, wantv, head.grant, waiting, index=i))
-        insts.append(counter(clk, rst, head.grant, words[i]))
+        moved, waiting = Signal(bool(0)), Signal(bool(0))
+        insts.append(grant_bits(gv, gv_r, wait_r, head.grant, moved, waiting, index=i))
+        insts.append(counter(clk, rst, moved, words[i]))
         insts.append(counter(clk, rst, waiting, waits[i]))
     insts.append(counter(clk, rst, one, clocks))
     insts.append(stat_mux(clk, stat, words, waits, clocks, sides, rect_lost, lcounts, lovf))
@@ -394,14 +414,27 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
 
 
 @block
-def activity(gv, wantv, grant, waiting, *, index: int):
-    """Master ``index`` is granted an access (moves a word) this clock / waited (asked or held a turn, not
-    granted)."""
+def activity(clk, rst, gv, reqv, startv, own1h, gv_r, wait_r):
+    """The grants and the waits, registered for the counters: master i was granted an access (moved a word)
+    / waited (asked, or held a turn with an access ready, and was not granted) in the clock before."""
+
+    @always_seq(clk.posedge, reset=rst)
+    def seq():
+        gv_r.next = gv
+        wait_r.next = (startv | (own1h & reqv)) & ~gv
+
+    return seq
+
+
+@block
+def grant_bits(gv, gv_r, wait_r, grant, moved, waiting, *, index: int):
+    """Master ``index``'s grant (this clock), and its registered grant and wait (the counters' inputs)."""
 
     @always_comb
     def comb():
         grant.next = gv[index]
-        waiting.next = wantv[index] and not gv[index]
+        moved.next = gv_r[index]
+        waiting.next = wait_r[index]
 
     return comb
 

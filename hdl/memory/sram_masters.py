@@ -22,7 +22,6 @@ from __future__ import annotations
 from myhdl import ConcatSignal, Signal, always, always_comb, always_seq, block, concat, intbv
 
 from eyestereo.hdl.common.arith import shift_add
-from eyestereo.hdl.common.fifo import sync_fifo
 from eyestereo.hdl.common.packed import pack_word, unpack_word
 from eyestereo.tools.models.sram_arbiter import FETCH_OFFSETS, Master
 from eyestereo.tools.packed import PackedWord
@@ -41,7 +40,8 @@ ACCESS = PackedWord("access", [("addr", ADDR_BITS), ("wdata", DATA_BITS), ("we",
 class Head:
     """One master's next access, as the arbiter sees it.
 
-    ``req``: an access is ready; ``start``: the master may start a turn (a writer: a burst is waiting);
+    ``req``: an access is ready (a register in every engine, so that the arbiter's grant starts at
+    flip-flops); ``start``: the master may start a turn (a writer: a burst is waiting);
     ``urgent``: it must be served before the round robin (the writers of streams that cannot wait);
     ``we, addr, wdata, be``: the access; ``tag``: the read's tag (``read_tag`` above the fetch index);
     ``grant`` (from the arbiter): the access is issued at this edge; ``access``: the access packed as
@@ -82,9 +82,10 @@ class EntrySignals:
 
 # ------------------------------------------------------------------------------------------------------
 @block
-def writer_issue(clk, rst, entry, valid, count, pop, push_eof, head, side, lcount0, lcount1, lovf,
+def writer_issue(clk, rst, din, push, push_eof, count, pop, head, side, lcount0, lcount1, lovf,
                  *, base0: int, base1: int, depth: int, burst: int, urgent: bool):
-    """The SRAM side of a writer: its FIFO's words to consecutive addresses of a buffer, frame by frame.
+    """The SRAM side of a writer: its FIFO (``depth`` entries of LUT-RAM, the head in a register) and the
+    FIFO's words to consecutive addresses of a buffer, frame by frame.
 
     A frame's first word (``sof``) takes a buffer from the double buffer when it reaches the head of the
     FIFO, i.e. after the previous frame's last word was issued and published, so back-to-back frames
@@ -93,26 +94,97 @@ def writer_issue(clk, rst, entry, valid, count, pop, push_eof, head, side, lcoun
     the word flagged ``eof`` publishes the buffer (``side.p_done``) and records the frame's word count
     (``lcount0``/``lcount1``) and overflow flag (``lovf``). An abort entry (a reset token) abandons the
     frame (``side.p_abort``).
+
+    ``head.req`` is a register: its next value is worked out for both answers of the arbiter (granted
+    or not, from registers and the LUT-RAM word behind the head) and the grant only chooses between the
+    two, so that the grant reaches every register here through one or two LUTs. A word pushed into an
+    empty FIFO is at the head (and asks) two clocks later; ``count`` (a register) counts every entry held.
     """
+    aw = depth.bit_length() - 1
+    mem = [Signal(intbv(0)[ENTRY_BITS:]) for _ in range(depth)]
+    wp, rp = Signal(intbv(0)[aw:]), Signal(intbv(0)[aw:])
+    stored = Signal(intbv(0, min=0, max=depth + 1))  # entries in the LUT-RAM (behind the head)
+    entry = Signal(intbv(0)[ENTRY_BITS:])            # the head entry
+    behind = Signal(intbv(0)[ENTRY_BITS:])           # the LUT-RAM's oldest entry (next at the head)
     waddr = head.addr
     eofs = Signal(intbv(0, min=0, max=depth + 1))  # entries with eof in the FIFO (frame ends, aborts)
     nwords = Signal(intbv(0)[len(lcount0):])       # words of the current frame issued so far
-    sof, eof, ovf, abt, has, claim, claimed, cur, discard, popped_eof = (Signal(bool(0)) for _ in range(10))
+    (sof, eof, ovf, abt, b_sof, b_abt, has, claim, claimed, cur, discard, popped_eof, load, claimed_n, discard_n,
+     req_g, req_n) = (Signal(bool(0)) for _ in range(17))
     cmax = (1 << len(lcount0)) - 1
     fields = unpack_word(entry, ENTRY, data=head.wdata, sof=sof, eof=eof, ovf=ovf, abt=abt)
+    ahead = unpack_word(behind, ENTRY, sof=b_sof, abt=b_abt)
+
+    @always_comb
+    def read():
+        behind.next = mem[rp]
+
+    @always(clk.posedge)
+    def store():
+        # the LUT-RAM and the head register (no reset: the valid flag says what they hold)
+        if load:
+            entry.next = behind
+        if push:
+            mem[wp].next = din
 
     @always_comb
     def present():
-        h = valid
-        has.next = h
+        h = has
         claim.next = h and sof and not claimed and not abt and not discard
-        head.req.next = h and not abt and not discard and (claimed or not sof)
         # entries that leave the FIFO without an access: aborts, a dropped frame's words
-        pop.next = head.grant or (h and (abt or discard or side.p_deny))
+        drop = h and (abt or discard or side.p_deny)
+        p = head.grant or drop
+        pop.next = p
+        load.next = stored != 0 and (not h or p)
         side.p_done.next = head.grant and eof
         side.p_done_buf.next = cur
         side.p_abort.next = h and abt and claimed
         side.p_abort_buf.next = cur
+
+    @always_comb
+    def frame_state():
+        # the buffer claim and the dropping of a frame after this edge, the grant's effect aside
+        claimed_n.next = (claimed or side.p_grant) and not (has and abt)
+        if discard and has and (eof or abt):
+            discard_n.next = False
+        elif side.p_deny and not side.p_grant:
+            discard_n.next = not eof
+        else:
+            discard_n.next = discard
+
+    @always_comb
+    def lookahead():
+        # head.req after this edge, granted (the head leaves; a frame's last word gives up the buffer) or not
+        drop = has and (abt or discard or side.p_deny)
+        req_g.next = stored != 0 and not b_abt and not discard_n and ((claimed_n and not eof) or not b_sof)
+        if stored != 0 and (not has or drop):
+            req_n.next = not b_abt and not discard_n and (claimed_n or not b_sof)
+        else:
+            req_n.next = has and not drop and not abt and not discard_n and (claimed_n or not sof)
+
+    @always_seq(clk.posedge, reset=rst)
+    def fifo():
+        # the grant only selects between the two precomputed answers
+        if head.grant:
+            head.req.next = req_g
+        else:
+            head.req.next = req_n
+        if load:
+            has.next = True
+            rp.next = (rp + 1) % depth
+            if not push:
+                stored.next = stored - 1
+        else:
+            if pop:
+                has.next = False
+            if push:
+                stored.next = stored + 1
+        if push:
+            wp.next = (wp + 1) % depth
+            if not pop:
+                count.next = count + 1
+        elif pop:
+            count.next = count - 1
 
     @always_seq(clk.posedge, reset=rst)
     def track():
@@ -123,7 +195,6 @@ def writer_issue(clk, rst, entry, valid, count, pop, push_eof, head, side, lcoun
         # a frame's first word at the head asks the double buffer for a buffer (answered a clock later)
         if side.p_grant:
             side.p_start.next = False
-            claimed.next = True
             cur.next = side.p_gbuf
             if side.p_gbuf:
                 waddr.next = base1
@@ -131,13 +202,10 @@ def writer_issue(clk, rst, entry, valid, count, pop, push_eof, head, side, lcoun
                 waddr.next = base0
         elif side.p_deny:
             side.p_start.next = False
-            discard.next = not eof
         else:
             side.p_start.next = claim
-        if discard and has and (eof or abt):
-            discard.next = False
-        if has and abt:
-            claimed.next = False
+        claimed.next = claimed_n
+        discard.next = discard_n
         if head.grant:
             waddr.next = waddr + 1
             if sof:
@@ -165,7 +233,7 @@ def writer_issue(clk, rst, entry, valid, count, pop, push_eof, head, side, lcoun
         elif popped_eof and not push_eof:
             eofs.next = eofs - 1
 
-    return fields, present, track
+    return fields, ahead, read, store, present, frame_state, lookahead, fifo, track
 
 
 # ------------------------------------------------------------------------------------------------------
@@ -367,12 +435,12 @@ def fetch_slave(clk, rst, fp, head, cbuf0, cbuf1, *, width: int, height: int, ba
         head.start.next = c_v
         head.tag.next = c_idx
         fp.req_ready.next = not a_v
-        # a stage moves on when the next one is empty or moves on itself
-        mc = head.grant and c_last
-        move_c.next = mc
-        move_p.next = p_v and (not c_v or mc)
-        move_b.next = b_v and (not p_v or not c_v or mc)
-        move_a.next = a_v and (not b_v or not p_v or not c_v or mc)
+        # a stage moves on when the next one is empty or moves on itself (each written out flat, so that
+        # the grant meets the stages' flags in one LUT, not through the chain of moves)
+        move_c.next = head.grant and c_last
+        move_p.next = p_v and (not c_v or (head.grant and c_last))
+        move_b.next = b_v and (not p_v or not c_v or (head.grant and c_last))
+        move_a.next = a_v and (not b_v or not p_v or not c_v or (head.grant and c_last))
 
     @always_seq(clk.posedge, reset=rst)
     def stages():
@@ -479,17 +547,17 @@ def host_slave(clk, rst, hp, head):
 @block
 def frame_writer(clk, rst, entry, push, count, head, side, lcount0, lcount1, lovf, *, base0: int, base1: int,
                  depth: int, burst: int, urgent: bool):
-    """A writer's FIFO (LUT-RAM, ``depth`` entries) and its SRAM side (:func:`writer_issue`); the input side
-    (:func:`camera_in`, :func:`rect_in`, :func:`feature_in`) pushes ``entry`` (:class:`EntrySignals`)."""
-    word = Signal(intbv(0)[ENTRY_BITS:])
-    pop, valid, push_eof = (Signal(bool(0)) for _ in range(3))
+    """A writer's FIFO and SRAM side (:func:`writer_issue`); the input side (:func:`camera_in`,
+    :func:`rect_in`, :func:`feature_in`) pushes ``entry`` (:class:`EntrySignals`)."""
+    if depth < 2 or depth & (depth - 1):
+        raise ValueError(f"frame_writer depth must be a power of two >= 2, got {depth}")
+    pop, push_eof = Signal(bool(0)), Signal(bool(0))
     eof_bit = ENTRY.bits("eof")[1]
 
     @always_comb
     def frame_end():
         push_eof.next = push and entry.word[eof_bit]
 
-    fifo = sync_fifo(clk, rst, entry.word, push, word, pop, count, valid, depth=depth)
-    issue = writer_issue(clk, rst, word, valid, count, pop, push_eof, head, side, lcount0, lcount1, lovf, base0=base0,
-                         base1=base1, depth=depth, burst=burst, urgent=urgent)
-    return frame_end, fifo, issue
+    issue = writer_issue(clk, rst, entry.word, push, push_eof, count, pop, head, side, lcount0, lcount1, lovf,
+                         base0=base0, base1=base1, depth=depth, burst=burst, urgent=urgent)
+    return frame_end, issue
