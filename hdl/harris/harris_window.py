@@ -190,7 +190,8 @@ def stereo_products(clk, rst, sink, prod, *, share: int):
     need (thesis Fig. 6.15: share 3 uses one). Each multiplier is registered on both sides: its operands
     2c + 1 come from registers loaded with the phase's pair (the sink's fields at the beat, the held
     copies after it), its product goes into a register; the rounding cut of the next clock writes the
-    phase's field of the product word.
+    phase's field of the product word. With three multipliers (share 1) each has operand registers of
+    its own (x * y reads the negated pair), so that none is shared by two multipliers.
     """
     m = multipliers(share)
     phases = -(-3 // m)
@@ -230,14 +231,32 @@ def stereo_products(clk, rst, sink, prod, *, share: int):
     qxy = fx_signal(model.PROD_XY)
     insts = [fields, hold, phase_flags]
     if m == 3:
-        # The held operands are the multipliers' input registers; one phase.
+        # One phase. Each multiplier has operand registers of its own, so that the placer can put each
+        # beside its multiplier: the squares read the held operands, x * y reads a negated pair,
+        # -(2c + 1) = 2 ~c + 1 (the code's bits inverted, a 1 appended; (-x) (-y) = x y). Being
+        # different bits, the pair is not merged with the held operands by the synthesis.
         fxx, fyy, fxy = range_signal(0, big), range_signal(0, big), range_signal(-big, big)
+        nx = fx_signal(sfix(10))  # -(2 Ix + 1)
+        ny = fx_signal(sfix(10))
+        sink_nx = fx_signal(sfix(10))
+        sink_ny = fx_signal(sfix(10))
+
+        @always_comb
+        def negated():
+            sink_nx.next = concat(~sink.data[xh:xl], True)
+            sink_ny.next = concat(~sink.data[yh:yl], True)
+
+        @always(clk.posedge)
+        def hold_negated():
+            if sink.valid:
+                nx.next = sink_nx
+                ny.next = sink_ny
 
         @always(clk.posedge)
         def multiply():
             fxx.next = opx * opx
             fyy.next = opy * opy
-            fxy.next = opx * opy
+            fxy.next = nx * ny
 
         sxx, syy, sxy = cut_signal(), cut_signal(), cut_signal()
 
@@ -247,7 +266,7 @@ def stereo_products(clk, rst, sink, prod, *, share: int):
             qyy.next = syy
             qxy.next = sxy
 
-        insts += [multiply, rounding(fxx, sxx), rounding(fyy, syy), rounding(fxy, sxy), cut]
+        insts += [negated, hold_negated, multiply, rounding(fxx, sxx), rounding(fyy, syy), rounding(fxy, sxy), cut]
     elif m == 2:
         # Multiplier 0: x * x, then x * y (the operand register b0 takes x at the beat, y after it);
         # multiplier 1: y * y on the held operand.

@@ -313,13 +313,23 @@ def nms3_one_delay(clk, rst, sink, source, *, width: int, height: int, share: in
         result.next = (aflag and c > prv[3] and c >= prv[1] and c >= cur[3] and c >= cur[2] and c >= cur[1]
                        and c > 0)
 
-    # A(x-1, y+1) for the next beat of the camera: cur[1] against prv[2], prv[1], prv[0].
+    # A(x-1, y+1) for the next beat of the camera: cur[1] against prv[2], prv[1], prv[0]. Only prv[0]
+    # comes from the line delay in the clock before; the two other comparisons are made a clock earlier,
+    # on the registers the chains shift into cur[1], prv[1], prv[2] (a_pre), so that the path into the
+    # line delay's write holds one comparator.
+    # (single names, not a list: MyHDL converts no signal that is in two lists)
+    cur_q1, prv_q1, prv_q3 = cur_links[1][1], prv_links[1][1], prv_links[3][1]
+    a_pre = Signal(bool(0))
     a_new = Signal(bool(0))
     a_hold = [Signal(bool(0)) for _ in range(2)]
 
+    @always(clk.posedge)
+    def above_early():
+        a_pre.next = cur_q1 > prv_q3 and cur_q1 > prv_q1
+
     @always_comb
     def above():
-        a_new.next = cur[1] > prv[2] and cur[1] > prv[1] and cur[1] > prv[0]
+        a_new.next = a_pre and cur[1] > prv[0]
 
     @always(clk.posedge)
     def hold():
@@ -342,7 +352,7 @@ def nms3_one_delay(clk, rst, sink, source, *, width: int, height: int, share: in
     def outreg():
         source.data.next = result
 
-    insts += [a_shift, decide, above, hold, bypass, outreg,
+    insts += [a_shift, decide, above_early, above, hold, bypass, outreg,
               window_control(clk, rst, sink, source, width=width, height=height, radius=1, latency=3, share=share,
                              lead_pixels=width + 2)]
     return insts

@@ -27,9 +27,10 @@ def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: i
     The camera count comes from the stream. On a stereo stream (left and right beat of each pixel in
     turn, ``cam`` forwarded) each camera has its own thresholds: the table has an entry per block and
     camera, addressed 2 * block + cam (as ``feature_list``'s counts), and one block position serves
-    both cameras. The camera of the beat due next is the one after the last beat's (left after a right
-    beat or a reset token), so a beat that breaks the left-right order (two of one camera in turn) is
-    compared with the other camera's threshold.
+    both cameras (:func:`camera_tables`: a memory per camera, both read a clock ahead, the camera due
+    picking the comparison). The camera of the beat due next is the one after the last beat's (left
+    after a right beat or a reset token), so a beat that breaks the left-right order (two of one camera
+    in turn) is compared with the other camera's threshold.
 
     Ports:
         clk, rst: clock and synchronous active-high reset.
@@ -48,9 +49,9 @@ def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: i
 
     Latency: 1 clock.
 
-    Resources: BX*BY x 20 bits of LUT-RAM (stereo: a table of 2^(ceil(log2(BX BY)) + 1) entries), a flag
-    register per entry, the threshold register, the block position counters, one comparator; (1, 1): one
-    threshold register per camera and no counters.
+    Resources: BX*BY x 20 bits of LUT-RAM (stereo: two memories of 2^ceil(log2(BX BY)) entries), a flag
+    register per entry, the threshold register (stereo: one per camera, and two comparators), the block
+    position counters, one comparator; (1, 1): one threshold register per camera and no counters.
     """
     nb = corner_model.OUT.wl
     check_clock(clk)
@@ -79,78 +80,141 @@ def prethreshold(clk, rst, sink, source, thr_we, thr_addr, thr_data, *, width: i
     y = Signal(intbv(0, min=0, max=height))
     blk = Signal(intbv(0, min=0, max=nblk))
     ahead = Signal(intbv(0, min=0, max=nblk))  # the block of the beat due next
+    value = fx_signal(corner_model.OUT)
+
+    @always_comb
+    def signed_view():
+        value.next = sink.data
+
+    position = block_position(clk, rst, sink, x, y, blk, ahead, width=width, height=height, blocks=blocks)
+    if sink.stereo:
+        return [signed_view, position, camera_tables(clk, rst, sink, source, value, thr_we, thr_addr, thr_data,
+                                                     ahead, abits=abits, nblk=nblk)]
     stored = Signal(intbv(0)[nb:])
     thr = fx_signal(corner_model.OUT)  # the threshold of the beat due, registered
-    value = fx_signal(corner_model.OUT)
-    insts = []
-    if sink.stereo:
-        # The table is addressed by (block, cam): the camera is the address's low bit. The beat due next is
-        # the right camera's after a left beat, else the left camera's.
-        entries = 1 << (abits + 1)
-        raddr = Signal(intbv(0)[abits + 1:])
-        due = Signal(bool(0))  # the camera of the beat due now
-        due_next = Signal(bool(0))
-
-        @always_comb
-        def address():
-            if sink.valid:
-                due_next.next = not sink.cam and not (sink.eof and not sink.eol)
-            else:
-                due_next.next = due
-            raddr.next = concat(ahead, due_next)
-
-        @always_seq(clk.posedge, reset=rst)
-        def camera():
-            due.next = due_next
-
-        insts += [address, camera]
-    else:
-        entries, raddr = nblk, ahead
-    mem = [Signal(intbv(0)[nb:]) for _ in range(entries)]
-    written = Signal(intbv(0)[entries:])
-
-    # A write to an index past the last block is ignored. When every address names a block the check
-    # is left out: GHDL 2.0's synthesis truncates the constant of "thr_addr < 16" to 4 bits (0), and
-    # the netlist make synth measures would then never write a threshold.
+    mem = [Signal(intbv(0)[nb:]) for _ in range(nblk)]
+    written = Signal(intbv(0)[nblk:])
     we = Signal(bool(0))
-    limit = cams * nblk
-    if limit >= (1 << len(thr_addr)):
-        @always_comb
-        def write_check():
-            we.next = thr_we
-    else:
-        @always_comb
-        def write_check():
-            we.next = thr_we and thr_addr < limit
 
     @always(clk.posedge)
     def ram():
         if we:
             mem[thr_addr].next = thr_data
 
+    @always_comb
+    def read():
+        stored.next = mem[ahead]
+
+
+    return [write_check(thr_we, thr_addr, we, limit=nblk), ram, written_flags(clk, rst, we, thr_addr, written), read,
+            entry_register(clk, rst, written, ahead, stored, thr), signed_view, position,
+            pass_greater(clk, rst, sink, source, value, thr)]
+
+
+@block
+def write_check(thr_we, thr_addr, we, *, limit: int):
+    """``we`` = ``thr_we`` for an address below ``limit`` (the table's entries): a write to an index past
+    the last block is ignored."""
+    # When every address names a block the check is left out: GHDL 2.0's synthesis truncates the constant
+    # of "thr_addr < 16" to 4 bits (0), and the netlist make synth measures would then never write a threshold.
+    if limit >= (1 << len(thr_addr)):
+        @always_comb
+        def all_entries():
+            we.next = thr_we
+    else:
+        @always_comb
+        def all_entries():
+            we.next = thr_we and thr_addr < limit
+    return all_entries
+
+
+@block
+def written_flags(clk, rst, we, addr, written):
+    """One flag per table entry, set by a write to it and cleared by ``rst``: an entry never written reads
+    as threshold 0."""
+
     @always_seq(clk.posedge, reset=rst)
     def flags():
         if we:
-            written.next[thr_addr] = 1
+            written.next[addr] = 1
 
-    @always_comb
-    def read():
-        stored.next = mem[raddr]
+    return flags
+
+
+@block
+def entry_register(clk, rst, written, index, stored, thr):
+    """``thr`` takes the table word read at ``index`` (``stored``), or 0 when that entry was never written."""
 
     @always_seq(clk.posedge, reset=rst)
     def fetch():
-        if written[raddr]:
+        if written[index]:
             thr.next = stored
         else:
             thr.next = 0
 
-    @always_comb
-    def signed_view():
-        value.next = sink.data
+    return fetch
 
-    return insts + [write_check, ram, flags, read, fetch, signed_view,
-                    block_position(clk, rst, sink, x, y, blk, ahead, width=width, height=height, blocks=blocks),
-                    pass_greater(clk, rst, sink, source, value, thr)]
+
+@block
+def camera_tables(clk, rst, sink, source, value, thr_we, thr_addr, thr_data, ahead, *, abits: int, nblk: int):
+    """:func:`prethreshold` of a stereo stream in BX x BY blocks (``ahead``: the block of the beat due next).
+
+    Entry 2 * block + cam of the table lives in the camera's memory (``mem_l``, ``mem_r``; the flags in
+    one vector ``written``, indexed 2 * block + cam). Both cameras' thresholds of the block due next are
+    read into registers (``thr_l``, ``thr_r``), and the beat is compared with both: the camera due
+    (``due``) picks the result. So the table read waits for no decoding of the beat's flags, and no
+    multiplexer stands in front of the comparators. The beat due next is the right camera's after a left
+    beat, else the left camera's.
+    """
+    nb = len(thr_data)
+    entries = 1 << (abits + 1)
+    mem_l = [Signal(intbv(0)[nb:]) for _ in range(1 << abits)]
+    mem_r = [Signal(intbv(0)[nb:]) for _ in range(1 << abits)]
+    written = Signal(intbv(0)[entries:])
+    we, we_l, we_r = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
+    wblk = Signal(intbv(0)[abits:])
+    raddr_l, raddr_r = Signal(intbv(0)[abits + 1:]), Signal(intbv(0)[abits + 1:])
+    stored_l, stored_r = Signal(intbv(0)[nb:]), Signal(intbv(0)[nb:])
+    thr_l, thr_r = fx_signal(corner_model.OUT), fx_signal(corner_model.OUT)
+    due = Signal(bool(0))  # the camera of the beat due now
+    due_next = Signal(bool(0))
+
+    @always_comb
+    def split():
+        wblk.next = thr_addr[abits + 1:1]
+        we_l.next = we and not thr_addr[0]
+        we_r.next = we and thr_addr[0]
+        raddr_l.next = concat(ahead, False)
+        raddr_r.next = concat(ahead, True)
+
+    @always(clk.posedge)
+    def ram():
+        if we_l:
+            mem_l[wblk].next = thr_data
+        if we_r:
+            mem_r[wblk].next = thr_data
+
+    @always_comb
+    def camera_due():
+        if sink.valid:
+            due_next.next = not sink.cam and not (sink.eof and not sink.eol)
+        else:
+            due_next.next = due
+
+    @always_seq(clk.posedge, reset=rst)
+    def camera():
+        due.next = due_next
+
+    @always_comb
+    def read():
+        stored_l.next = mem_l[ahead]
+        stored_r.next = mem_r[ahead]
+
+
+    return [write_check(thr_we, thr_addr, we, limit=2 * nblk), split, ram, written_flags(clk, rst, we, thr_addr, written),
+            camera_due, camera, read, entry_register(clk, rst, written, raddr_l, stored_l, thr_l),
+            entry_register(clk, rst, written, raddr_r, stored_r, thr_r),
+            pass_greater(clk, rst, sink, source, value, thr_l, thr_r, due)]
 
 
 @block
@@ -196,9 +260,10 @@ def global_threshold(clk, rst, sink, source, thr_we, thr_addr, thr_data):
 
 
 @block
-def pass_greater(clk, rst, sink, source, value, thr):
+def pass_greater(clk, rst, sink, source, value, thr, thr_right=None, right=None):
     """The output register: the sink's beat (``cam`` too on a stereo stream), its data kept where
-    value > thr, else 0."""
+    value > thr, else 0. With ``thr_right`` and ``right``: value > (thr_right where ``right``, else thr),
+    both comparisons made and the result picked (no multiplexer in front of a comparator)."""
 
     @always_seq(clk.posedge, reset=rst)
     def emit():
@@ -208,18 +273,42 @@ def pass_greater(clk, rst, sink, source, value, thr):
 
     # The data register has no reset (its value counts only with valid): the comparison alone clears it, as
     # the flip-flops' synchronous reset, with no gate before.
-    @always(clk.posedge)
-    def data():
-        if value > thr:
-            source.data.next = sink.data
-        else:
-            source.data.next = 0
+    if thr_right is None:
+        @always(clk.posedge)
+        def data():
+            if value > thr:
+                source.data.next = sink.data
+            else:
+                source.data.next = 0
 
+        insts = [emit, data]
+    else:
+        gt_l, gt_r, keep = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
+
+        # An AND-OR rather than an if: a multiplexer of two comparisons would be folded by the synthesis
+        # into one comparison of multiplexed operands.
+        @always_comb
+        def compare():
+            gt_l.next = value > thr
+            gt_r.next = value > thr_right
+
+        @always_comb
+        def pick():
+            keep.next = (gt_l and not right) or (gt_r and right)
+
+        @always(clk.posedge)
+        def data():
+            if keep:
+                source.data.next = sink.data
+            else:
+                source.data.next = 0
+
+        insts = [emit, compare, pick, data]
     if not sink.stereo:
-        return emit, data
+        return insts
 
     @always_seq(clk.posedge, reset=rst)
     def camera():
         source.cam.next = sink.cam
 
-    return emit, data, camera
+    return insts + [camera]

@@ -72,8 +72,12 @@ class FrameControl(Bundle):
         cycle        0    1    2    3    4    5    6
         avail[0:1]   01   11   11   00   00   00   01     camera 1 finishes, camera 0 finishes
         cam_want     #    #    #    #    #    #    #
-        cam_held     _    _    #    #    #    _    _      taken at the edge after both are available
+        cam_held     _    _    _    #    #    _    _      taken at the second edge after both are available
         cam_release  _    _    _    _    #    _    _
+
+    The camera pair's take is registered in the arbiter (cycle 1 decides, the edge after cycle 2 takes):
+    ``cam_held`` rises two clocks after the clock in which both cameras' ``avail`` bits are high, the
+    rectified and feature consumers' one clock after theirs.
     """
 
     MEMBERS = (Member("cam_run", 2, OUT), Member("cam_arm", 2, OUT), Member("cam_want", bool, OUT),

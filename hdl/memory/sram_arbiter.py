@@ -165,6 +165,16 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     # ---- frame handshake ------------------------------------------------------------------------
     run0, run1, arm0, arm1 = (Signal(bool(0)) for _ in range(4))
     s_c0, s_c1, s_r, s_f = (side_of[n] for n in ("cam0", "cam1", "rect", "feat"))
+    cam_take = Signal(bool(0))
+
+    @always_seq(clk.posedge, reset=rst)
+    def pair_take():
+        # The camera pair is taken a clock after both buffers offer a frame: the decision spans both
+        # double buffers and the sequencer's want, and a take feeds each buffer's producer choice and
+        # counters (the memory clock's worst path, issue 23), so it starts from this register. A frame
+        # offered stays offered for that clock: only a take or a release ends c_avail, and a producer's
+        # start there picks a FREE buffer or the older of two FULL ones (the newest stays to be taken).
+        cam_take.next = ctl.cam_want and s_c0.c_avail and s_c1.c_avail and not cam_take
 
     @always_comb
     def control():
@@ -172,9 +182,8 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
         run1.next = ctl.cam_run[1]
         arm0.next = ctl.cam_arm[0]
         arm1.next = ctl.cam_arm[1]
-        take = ctl.cam_want and s_c0.c_avail and s_c1.c_avail
-        s_c0.c_take.next = take
-        s_c1.c_take.next = take
+        s_c0.c_take.next = cam_take
+        s_c1.c_take.next = cam_take
         s_c0.c_release.next = ctl.cam_release
         s_c1.c_release.next = ctl.cam_release
         ctl.cam_held.next = s_c0.c_held
@@ -190,7 +199,7 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
 
     fulls = [Signal(bool(0)) for _ in sides]
     insts += [any_full(sd.state, f) for sd, f in zip(sides, fulls)]
-    insts += [control, assign(ConcatSignal(*reversed(fulls)), ctl.avail)]
+    insts += [pair_take, control, assign(ConcatSignal(*reversed(fulls)), ctl.avail)]
     del fulls
 
     # ---- the masters' engines, from the table -----------------------------------------------------

@@ -391,6 +391,7 @@ def fetch_slave(clk, rst, fp, head, cbuf0, cbuf1, *, width: int, height: int, ba
     c0, c1, c2, c3 = cs = [Signal(intbv(0)[ADDR_BITS:]) for _ in FETCH_OFFSETS]
     c_idx = Signal(intbv(0)[2:])
     c_last = Signal(bool(0))
+    c_rest, p_rest, r_rest = (Signal(intbv(0)[4:]) for _ in range(3))
     move_a, move_b, move_p, move_c = (Signal(bool(0)) for _ in range(4))
     (l0b0, l0b1), (l1b0, l1b1) = bases
 
@@ -427,7 +428,6 @@ def fetch_slave(clk, rst, fp, head, cbuf0, cbuf1, *, width: int, height: int, ba
         else:
             c_idx.next = 3
             head.addr.next = c3
-        c_last.next = c_mask == 1 or c_mask == 2 or c_mask == 4 or c_mask == 8
 
     @always_comb
     def present():
@@ -474,20 +474,39 @@ def fetch_slave(clk, rst, fp, head, cbuf0, cbuf1, *, width: int, height: int, ba
             b_mask.next = a_mask
         if move_b:
             p_mask.next = b_mask
+        # the mask after this grant (c_rest) and whether this grant is the request's last (c_last) are kept
+        # in registers, worked out from the mask loaded or the rest before, so that the grant meets only
+        # a multiplexer on its way into them (the memory clock's goal, issue 23)
         if move_p:
             c_mask.next = p_mask
+            c_rest.next = p_rest
+            c_last.next = p_mask != 0 and p_rest == 0
         elif head.grant:
-            if c_mask[0]:
-                c_mask.next[0] = 0
-            elif c_mask[1]:
-                c_mask.next[1] = 0
-            elif c_mask[2]:
-                c_mask.next[2] = 0
-            else:
-                c_mask.next[3] = 0
+            c_mask.next = c_rest
+            c_rest.next = r_rest
+            c_last.next = c_rest != 0 and r_rest == 0
 
-    insts += [base_select, current, present, stages, data]
+    insts += [base_select, current, present, stages, data, lowest_cleared(p_mask, p_rest),
+              lowest_cleared(c_rest, r_rest)]
     return insts
+
+
+@block
+def lowest_cleared(mask, rest):
+    """``rest`` = the 4-bit ``mask`` without its lowest set bit (the fetch index granted first)."""
+
+    @always_comb
+    def comb():
+        if mask[0]:
+            rest.next = mask & 0b1110
+        elif mask[1]:
+            rest.next = mask & 0b1100
+        elif mask[2]:
+            rest.next = mask & 0b1000
+        else:
+            rest.next = 0
+
+    return comb
 
 
 @block

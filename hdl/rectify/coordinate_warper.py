@@ -59,10 +59,10 @@ def coordinate_warper(clk, rst, start, enable, busy, done, coord, coef=None, *, 
     from the next clock until the frame's last pair (``eof``) has been taken; ``done`` is high for the one
     clock after that take (``busy`` low again; a ``start`` in that clock begins the next frame)::
 
-        cycle     s   s+1  ...  s+13 ...    e   e+1
+        cycle     s   s+1  ...  s+14 ...    e   e+1
         start     #    _         _          _    .
         busy      _    #    #    #    #     #    _
-        valid     _    _    _    #   ...    #    .      (first pair in clock s + 13; last pair: eof)
+        valid     _    _    _    #   ...    #    .      (first pair in clock s + 14; last pair: eof)
         read_ack  .    .    .    .   ...    #    .
         done      _    _    _    _    _     _    #
 
@@ -86,7 +86,7 @@ def coordinate_warper(clk, rst, start, enable, busy, done, coord, coef=None, *, 
             (default: the synthetic rig, 352x288, frac = q24's fraction length, 5). The rectified size (the
             counters) is the calibration's ``width`` x ``height``.
 
-    Latency: the first pair is offered 13 clocks after the ``start`` clock (:data:`FIRST_PAIR`); then one
+    Latency: the first pair is offered 14 clocks after the ``start`` clock (:data:`FIRST_PAIR`); then one
     pair per 4 clocks while the consumer keeps up: ``done`` 4 x width x height + 10 clocks after ``start``.
 
     Resources: the calculation unit, two counters, the R1 and R2 register levels (2 x 4 coordinates,

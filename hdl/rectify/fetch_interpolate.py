@@ -16,7 +16,7 @@ __all__ = ["DEFAULT_DEPTH", "FIRST_PIXEL", "fetch_interpolate"]
 
 #: Clocks from the clock a pair is taken to its left pixel on ``source``, both sides in range and the
 #: memory answering at once (the timing diagram of :func:`fetch_interpolate`).
-FIRST_PIXEL = 11
+FIRST_PIXEL = 12
 #: Default number of sides (requests or black pixels) in flight between the request and the output.
 DEFAULT_DEPTH = 4
 #: The 1-bit fields of the side word (:func:`eyestereo.tools.models.fetch_interpolate.side_word`), bool signals here.
@@ -69,14 +69,14 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
     Timing, one pair with both sides in range, the memory answering at once (``F`` a fetch beat, ``s``
     an interpolation step)::
 
-        cycle       0    1    2    3    4    5    6    7    8    9   10   11   12   13   14   15
-        coord.valid #    .    .    .    .    .    .    .    .    .    .    .    .    .    .    .
-        read_ack    #    _    _    .    .    .    .    .    .    .    .    .    .    .    .    .
-        req_valid   _    #L   #R   _    _    _    _    _    _    _    _    _    _    _    _    _
-        rsp_valid   _    _    F    F    F    F    _    _    _    _    _    _    _    _    _    _
-        steps (L)   _    _    _    _    s0   s1   s2   s3   _    _    _    _    _    _    _    _
-        steps (R)   _    _    _    _    _    _    _    _    s0   s1   s2   s3   _    _    _    _
-        source      _    _    _    _    _    _    _    _    _    _    _    L    _    _    _    R
+        cycle       0    1    2    3    4    5    6    7    8    9   10   11   12   13   14   15   16
+        coord.valid #    .    .    .    .    .    .    .    .    .    .    .    .    .    .    .    .
+        read_ack    #    _    _    .    .    .    .    .    .    .    .    .    .    .    .    .    .
+        req_valid   _    #L   #R   _    _    _    _    _    _    _    _    _    _    _    _    _    _
+        rsp_valid   _    _    F    F    F    F    _    _    _    _    _    _    _    _    _    _    _
+        steps (L)   _    _    _    _    _    s0   s1   s2   s3   _    _    _    _    _    _    _    _
+        steps (R)   _    _    _    _    _    _    _    _    _    s0   s1   s2   s3   _    _    _    _
+        source      _    _    _    _    _    _    _    _    _    _    _    _    L    _    _    _    R
 
     (with 2 pixels fetched per side; the steps of the next pairs follow without gaps while pairs come):
     8 clocks per stereo output pixel when both sides are in range, fewer for black sides.
@@ -99,8 +99,8 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
             4 x ``depth`` entries.
 
     Latency: a side's pixel leaves 4 clocks after its last step; with a memory answering at once the
-    first pixel of a frame comes 11 clocks after its pair is taken (:data:`FIRST_PIXEL`; 9 before the
-    stages were split for the 110 MHz goal).
+    first pixel of a frame comes 12 clocks after its pair is taken (:data:`FIRST_PIXEL`; 9 before the
+    stages were split and the response pixel registered for the 110 MHz goal).
 
     Resources: 2 multipliers (the weight ``(F+1) x (F+1)`` bits, the weight times the pixel), two
     show-ahead FIFOs (queue ``depth`` x 18..32 bits, pixels 4 x ``depth`` x 8 bits, LUT-RAM), 8 kept
@@ -110,24 +110,37 @@ def fetch_interpolate(clk, rst, coord, fetch, source, busy, *, depth: int = DEFA
     word = model.side_word(coord.frac)
     side, head = FieldSignals(word, _FLAGS), FieldSignals(word, _FLAGS)  # being requested; at the queue's head
     side_in, side_out = Signal(intbv(0)[word.width:]), Signal(intbv(0)[word.width:])
+    side_fifo, side_fifo_pop, hq, room = (Signal(intbv(0)[word.width:]), Signal(bool(0)), Signal(bool(0)),
+                                          Signal(bool(0)))
     push, pop = Signal(bool(0)), Signal(bool(0))
     queued = Signal(intbv(0, min=0, max=depth + 1))
     pixel, rpop = Signal(intbv(0)[8:]), Signal(bool(0))
+    fifo_word, fifo_pop, hv = Signal(intbv(0)[8:]), Signal(bool(0)), Signal(bool(0))
     held = Signal(intbv(0, min=0, max=4 * depth + 1))
     requesting, running = Signal(bool(0)), Signal(bool(0))
 
     @always_comb
     def busy_out():
-        busy.next = requesting or queued != 0 or running
+        busy.next = requesting or queued != 0 or hq or running
 
-    return (requester(clk, rst, coord, fetch, side, push, queued, requesting, depth=depth),
+    @always_comb
+    def in_flight():
+        # sides in flight: the queue's and the one in the head register; at most depth
+        if hq:
+            room.next = queued < depth - 1
+        else:
+            room.next = queued < depth
+
+    return (requester(clk, rst, coord, fetch, side, push, room, requesting),
             pack_word(side_in, word, **side.fields()),
-            show_ahead_fifo(clk, rst, side_in, push, side_out, pop, queued, depth=depth),
+            show_ahead_fifo(clk, rst, side_in, push, side_fifo, side_fifo_pop, queued, depth=depth),
+            head_register(clk, rst, side_fifo, queued, side_fifo_pop, side_out, hq, pop),
             unpack_word(side_out, word, **head.fields()),
             # at most depth sides wait, each for at most 4 pixels: every response fits
-            show_ahead_fifo(clk, rst, fetch.rsp_data, fetch.rsp_valid, pixel, rpop, held, depth=4 * depth),
-            interpolator(clk, rst, head, queued, pixel, held, pop, rpop, source, running, frac=coord.frac),
-            busy_out)
+            show_ahead_fifo(clk, rst, fetch.rsp_data, fetch.rsp_valid, fifo_word, fifo_pop, held, depth=4 * depth),
+            head_register(clk, rst, fifo_word, held, fifo_pop, pixel, hv, rpop),
+            interpolator(clk, rst, head, hq, pixel, hv, pop, rpop, source, running, frac=coord.frac),
+            busy_out, in_flight)
 
 
 def _check(clk, rst, coord, fetch, source, busy, depth) -> int:
@@ -162,7 +175,7 @@ def _check(clk, rst, coord, fetch, source, busy, depth) -> int:
 
 
 @block
-def requester(clk, rst, coord, fetch, side, push, queued, requesting, *, depth: int):
+def requester(clk, rst, coord, fetch, side, push, room, requesting):
     """Takes a pair (``read_ack`` while idle), then its left side and its right: ``push`` queues the side
     (the fields of ``side``) in the clock its request moves, or at once when it needs none; ``requesting``
     is high from the pair's clock to its right side's push."""
@@ -170,7 +183,7 @@ def requester(clk, rst, coord, fetch, side, push, queued, requesting, *, depth: 
     ix, iy = len(coord.xl) - frac, len(coord.yl) - frac
     IDLE, LEFT, RIGHT = 0, 1, 2
     state = Signal(intbv(0, min=0, max=3))
-    take, need, space = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
+    take, need, space, to_right = Signal(bool(0)), Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
     x0, y0 = Signal(intbv(0)[ix:]), Signal(intbv(0)[iy:])
     # per camera: the integer position of the pair on offer, its tag, the reuse rule's mask and sources on
     # them (computed while the pair is offered and registered when it is taken, so that the request path
@@ -192,11 +205,12 @@ def requester(clk, rst, coord, fetch, side, push, queued, requesting, *, depth: 
         requesting.next = state != IDLE
         side.cam.next = state == RIGHT
         need.next = not side.oor and side.mask != 0
-        space.next = queued < depth
+        space.next = room
 
     @always_comb
     def request():
         push.next = state != IDLE and space and (not need or fetch.req_ready)
+        to_right.next = state == LEFT and space and (not need or fetch.req_ready)
         fetch.req_valid.next = state != IDLE and need and space
         fetch.req_cam.next = side.cam
         fetch.req_mask.next = side.mask
@@ -242,56 +256,51 @@ def requester(clk, rst, coord, fetch, side, push, queued, requesting, *, depth: 
             side.src.next = ksrc[0]
 
     return (control, request, states, offered, rule_taken, rule_of_side,
-            pair_side(clk, rst, coord, take, side, x0, y0), tags(clk, rst, push, side, x0, y0, tx, ty, tv),
+            pair_side(clk, rst, coord, take, to_right, side, x0, y0), tags(clk, rst, push, side, x0, y0, tx, ty, tv),
             [reuse_rule(cx[c], cy[c], tx[c], ty[c], tv[c], rmask[c], rsrc[c]) for c in range(2)])
 
 
 @block
-def pair_side(clk, rst, coord, take, side, x0, y0):
-    """The pair taken (registers, with its ``eol``/``eof`` as the side's) and, by ``side.cam``, the side's
-    integer position ``x0``, ``y0``, its fractions and its out-of-range flag."""
+def pair_side(clk, rst, coord, take, to_right, side, x0, y0):
+    """The pair taken (its right side kept in registers, its ``eol``/``eof`` as the sides') and the current
+    side in registers: its integer position ``x0``, ``y0``, fractions and out-of-range flag, loaded with the
+    left side's at ``take`` and with the right side's at ``to_right`` (the left side's push). Registers, not
+    a multiplexer on ``side.cam``: the position goes straight into the fetch port's address arithmetic
+    (the memory clock's goal, issue 23)."""
     frac = coord.frac
     nx, ny, fw = len(coord.xl), len(coord.yl), len(side.dx)
-    xl, xr = Signal(intbv(0)[nx:]), Signal(intbv(0)[nx:])
-    yl, yr = Signal(intbv(0)[ny:]), Signal(intbv(0)[ny:])
-    oorl, oorr = Signal(bool(0)), Signal(bool(0))
+    xr, yr = Signal(intbv(0)[nx:]), Signal(intbv(0)[ny:])
+    oorr = Signal(bool(0))
 
     @always_seq(clk.posedge, reset=rst)
     def capture():
         if take:
-            xl.next = coord.xl
-            yl.next = coord.yl
             xr.next = coord.xr
             yr.next = coord.yr
-            oorl.next = coord.oor_l
             oorr.next = coord.oor_r
             side.eol.next = coord.eol
             side.eof.next = coord.eof
-
-    @always_comb
-    def position():
-        if side.cam:
+            side.oor.next = coord.oor_l
+            x0.next = coord.xl[nx:frac]
+            y0.next = coord.yl[ny:frac]
+            if frac == 0:
+                side.dx.next = 0
+                side.dy.next = 0
+            else:
+                side.dx.next = coord.xl[fw:0]
+                side.dy.next = coord.yl[fw:0]
+        elif to_right:
             side.oor.next = oorr
             x0.next = xr[nx:frac]
             y0.next = yr[ny:frac]
-        else:
-            side.oor.next = oorl
-            x0.next = xl[nx:frac]
-            y0.next = yl[ny:frac]
+            if frac == 0:
+                side.dx.next = 0
+                side.dy.next = 0
+            else:
+                side.dx.next = xr[fw:0]
+                side.dy.next = yr[fw:0]
 
-    @always_comb
-    def fractions():
-        if frac == 0:
-            side.dx.next = 0
-            side.dy.next = 0
-        elif side.cam:
-            side.dx.next = xr[fw:0]
-            side.dy.next = yr[fw:0]
-        else:
-            side.dx.next = xl[fw:0]
-            side.dy.next = yl[fw:0]
-
-    return capture, position, fractions
+    return capture
 
 
 @block
@@ -328,36 +337,28 @@ def reuse_rule(x0, y0, tx, ty, tv, mask, src):
     and where each kept pixel comes from, ``src``."""
     ix, iy = len(x0), len(y0)
     MASK_T, SRC_T = _tables()
-    XOFF, YOFF = (1 << (ix + 1)) + 1, (1 << (iy + 1)) + 1
-    ex, ey = Signal(intbv(0)[ix + 2:]), Signal(intbv(0)[iy + 2:])
-    exl, eyl = Signal(intbv(0)[ix + 1:]), Signal(intbv(0)[iy + 1:])
+    # The tag's neighbours tx - 1, tx + 1 (ty alike) are worked out from the tag alone, so the position on
+    # offer (which comes from the coordinate warper's registers, far away in the netlist) meets only
+    # equality compares: no carry chain on its way to the rule's registers (issue 23). On ix + 1 bits, so
+    # that tx - 1 for tx = 0 (all ones) and tx + 1 for the last column never equal a position.
+    xm, xp = Signal(intbv(0)[ix + 1:]), Signal(intbv(0)[ix + 1:])
+    ym, yp = Signal(intbv(0)[iy + 1:]), Signal(intbv(0)[iy + 1:])
+    xmw, ymw = Signal(intbv(0)[ix + 2:]), Signal(intbv(0)[iy + 2:])
+    XM, YM = (1 << (ix + 1)) - 1, (1 << (iy + 1)) - 1  # + 2**(n+1) - 1: minus one, modulo 2**(n+1)
     cx, cy = Signal(intbv(0)[2:]), Signal(intbv(0)[2:])
     code = Signal(intbv(0)[4:])
 
     @always_comb
-    def offsets():
-        # x0 - tx + 1 kept positive by 2**(ix+1): its low ix+1 bits are 0, 1, 2 for ddx = -1, 0, 1 (one
-        # subtraction; no signed values, no negative constants: MyHDL's Verilog compares a signed case
-        # expression with unsigned negative items)
-        ex.next = x0 + XOFF - tx
-        ey.next = y0 + YOFF - ty
+    def neighbours():
+        xmw.next = tx + XM
+        ymw.next = ty + YM
+        xp.next = tx + 1
+        yp.next = ty + 1
 
     @always_comb
-    def offsets_low():
-        exl.next = ex[ix + 1:0]
-        eyl.next = ey[iy + 1:0]
-
-    @always_comb
-    def steps():
-        # 3 = no reuse (the low ix+1 bits are 0..2 only for ddx = -1..1)
-        if exl < 3:
-            cx.next = exl[2:0]
-        else:
-            cx.next = 3
-        if eyl < 3:
-            cy.next = eyl[2:0]
-        else:
-            cy.next = 3
+    def neighbours_low():
+        xm.next = xmw[ix + 1:0]
+        ym.next = ymw[iy + 1:0]
 
     @always_comb
     def table_index():
@@ -374,14 +375,34 @@ def reuse_rule(x0, y0, tx, ty, tv, mask, src):
     def src_rom():
         src.next = SRC_T[code]
 
-    return offsets, offsets_low, steps, table_index, mask_rom, src_rom
+    return (neighbours, neighbours_low, step_code(x0, tx, xm, xp, cx), step_code(y0, ty, ym, yp, cy), table_index,
+            mask_rom, src_rom)
+
+
+@block
+def step_code(pos, tag, below, above, code):
+    """The reuse rule's step on one axis: ``pos - tag`` = -1 -> 0, 0 -> 1, +1 -> 2, anything else 3 (no
+    reuse), from equality compares with the tag and its neighbours ``below`` = tag - 1, ``above`` = tag + 1."""
+
+    @always_comb
+    def comb():
+        if pos == tag:
+            code.next = 1
+        elif pos == below:
+            code.next = 0
+        elif pos == above:
+            code.next = 2
+        else:
+            code.next = 3
+
+    return comb
 
 
 # ------------------------------------------------------------------ interpolator
 
 
 @block
-def interpolator(clk, rst, head, queued, pixel, held, pop, rpop, source, running, *, frac: int):
+def interpolator(clk, rst, head, hq, pixel, hv, pop, rpop, source, running, *, frac: int):
     """Four multiply-accumulate steps per queued side, one for a black side (module docstring): ``pop``
     with the side's last step, ``rpop`` with each step whose pixel comes from the response FIFO."""
     step = Signal(intbv(0, min=0, max=4))
@@ -393,10 +414,10 @@ def interpolator(clk, rst, head, queued, pixel, held, pop, rpop, source, running
     @always_comb
     def step_fire():
         fetched.next = not head.oor and head.mask[step]
-        fire.next = queued != 0 and (not fetched or held != 0)
+        fire.next = hq and (not fetched or hv)
         last.next = head.oor or step == 3
-        rpop.next = queued != 0 and fetched and held != 0
-        pop.next = queued != 0 and (not fetched or held != 0) and (head.oor or step == 3)
+        rpop.next = hq and fetched and hv
+        pop.next = hq and (not fetched or hv) and (head.oor or step == 3)
         pix.next = pixel if fetched else kpix
 
     @always_seq(clk.posedge, reset=rst)
@@ -409,6 +430,32 @@ def interpolator(clk, rst, head, queued, pixel, held, pop, rpop, source, running
 
     return (step_fire, steps, kept_pixels(clk, fire, head, step, pix, kpix), step_weight(step, head, wa, wb, frac=frac),
             mac(clk, rst, fire, last, step, head, wa, wb, pix, source, running, frac=frac))
+
+
+@block
+def head_register(clk, rst, fifo_word, level, fifo_pop, pixel, hv, take):
+    """A show-ahead FIFO's oldest word in a register (``pixel``, valid while ``hv``): refilled from the
+    FIFO in the clock the interpolator ``take``s it, or whenever it is empty. The interpolator's paths
+    (the side's flags, the response pixel) then start at this register, not at the FIFO's pointer and
+    LUT-RAM (the memory clock's worst paths, issue 23); one clock more from the FIFO to the step."""
+
+    @always_comb
+    def refill():
+        fifo_pop.next = level != 0 and (not hv or take)
+
+    @always_seq(clk.posedge, reset=rst)
+    def valid():
+        if level != 0 and (not hv or take):
+            hv.next = True
+        elif take:
+            hv.next = False
+
+    @always(clk.posedge)
+    def word():
+        if level != 0 and (not hv or take):
+            pixel.next = fifo_word
+
+    return refill, valid, word
 
 
 @block
@@ -501,8 +548,17 @@ def mac(clk, rst, fire, last, step, head, wa, wb, pix, source, running, *, frac:
     HALF = (1 << (2 * frac)) >> 1
 
     @always_seq(clk.posedge, reset=rst)
-    def stages():
+    def valid_bits():
         v1.next = fire
+        v2.next = v1
+        v3.next = v2
+        v4.next = v3 and last3
+        source.valid.next = v4
+
+    # The data registers have no reset (the valid bits say what they hold): so the multipliers' operand
+    # and product registers can live inside the ECP5's DSP blocks (hdl/flow/dsp_regs.py).
+    @always(clk.posedge)
+    def stages():
         if fire:
             first1.next = step == 0
             last1.next = last
@@ -514,25 +570,21 @@ def mac(clk, rst, fire, last, step, head, wa, wb, pix, source, running, *, frac:
                 wa1.next = wa
                 p1.next = pix
             wb1.next = wb
-        v2.next = v1
         first2.next = first1
         last2.next = last1
         t2.next = t1
         w2.next = wa1 * wb1
         p2.next = p1
-        v3.next = v2
         first3.next = first2
         last3.next = last2
         t3.next = t2
         m3.next = w2 * p2
-        v4.next = v3 and last3
         if v3:
             t4.next = t3
             if first3:
                 acc.next = m3
             else:
                 acc.next = acc + m3
-        source.valid.next = v4
         if v4:
             source.data.next = rounded[ACC:2 * frac]
             source.cam.next = t4[2]
@@ -547,4 +599,4 @@ def mac(clk, rst, fire, last, step, head, wa, wb, pix, source, running, *, frac:
     def running_out():
         running.next = v1 or v2 or v3 or v4
 
-    return stages, rounding, running_out
+    return valid_bits, stages, rounding, running_out

@@ -5,7 +5,7 @@ from __future__ import annotations
 from myhdl import Signal, always, always_comb, always_seq, block, intbv
 
 from eyestereo.hdl.common.checks import block_error, check_clock, check_distinct, check_int, check_reset, check_signal
-from eyestereo.hdl.common.quantize import fmt_signal, fx_add, fx_mul, fx_resize
+from eyestereo.hdl.common.quantize import fmt_signal, fx_add, fx_mul, fx_mul_reg, fx_resize
 from eyestereo.hdl.common.registers import assign
 from eyestereo.hdl.rectify.calibration import calibration_param
 from eyestereo.tools.fixed import Fmt, ufix
@@ -97,7 +97,7 @@ def low2(sel, index):
 def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_coord_out, coef=None, *,
               quantizers=None, frac: int | None = model.DEFAULT_FRAC, source_width: int | None = None,
               source_height: int | None = None):
-    """Four degree-3 polynomials in one 8-stage pipeline with 9 multipliers: one coordinate per clock.
+    """Four degree-3 polynomials in one 9-stage pipeline with 9 multipliers: one coordinate per clock.
 
     Evaluates ``p1 + y(p3 + p6 x + y(p5 + p8 y + p10 x)) + x(p2 + x(p4 + p7 x + p9 y))`` bit for bit as
     the toolbox's float-to-fixed conversion defines it (26 quantizers, floor and wrap, numbered as
@@ -116,9 +116,10 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
         C      q20 = p5 + q11 + q12, q21 = p4 + q13 + q14       p5 p4 into the adders
         D      q15 = q20 Y, q16 = p6 X, q17 = q21 X
         E      q22 = q15 + p3 + q16, q23 = q17 + p2             p3 p2 into the adders
-        F      q18 = q22 Y, q19 = q23 X
-        G      q24 = p1 + q18 + q19                             p1 into the adder
-        H      coord = q24 cut to frac bits, out_of_range, select_coord_out
+        F      partial products of q22 Y and q23 X              (one per 18x18 multiplier)
+        G      q18 = q22 Y, q19 = q23 X (the partial products added)
+        H      q24 = p1 + q18 + q19                             p1 into the adder
+        I      coord = q24 cut to frac bits, out_of_range, select_coord_out
 
     The multipliers' coefficients are chosen by the select code one stage ahead and registered, so every
     multiplier takes both operands straight from registers; the addends p1..p5 are chosen in the stage
@@ -151,11 +152,14 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
         source_width, source_height: the camera images the coordinates point into (default: the
             document's ``source_width``/``source_height``, else its rectified size).
 
-    Latency: 8 clocks (8 enabled clocks): a coordinate presented at the input in clock t is at the
-    output in clock t + 8 when ``enable`` stays high.
+    Latency: 9 clocks (9 enabled clocks): a coordinate presented at the input in clock t is at the
+    output in clock t + 9 when ``enable`` stays high. (The thesis's unit has 8 stages; the last products
+    take two here, issue 23: with the synthetic rig q22 has 19 bits, so q22 * Y is two hardware
+    multipliers and an adder, too slow for one 110 MHz clock in the whole front end.)
 
     Resources: 9 multipliers (MULT18X18 where the merged formats keep both operands within 18 signed
-    bits; the synthetic rig's q18 = q22 * Y has a 19-bit operand), the adders, pipeline registers for
+    bits; the synthetic rig's q18 = q22 * Y has a 19-bit operand: two, their partial products registered
+    and added in the next stage), the adders, pipeline registers for
     X, Y, select and the coefficients (4-entry constant tables, or LUT-RAM with ``coef``).
     """
     check_clock(clk)
@@ -187,12 +191,12 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
     insts = []
 
     # --- select pipeline (valid bits reset) and the coefficient index of each stage
-    sels = {s: Signal(intbv(0)[3:]) for s in "ABCDEFG"}
-    idx = {s: Signal(intbv(0)[2:]) for s in ("in", "A", "B", "D", "F")}
+    sels = {s: Signal(intbv(0)[3:]) for s in "ABCDEFGH"}
+    idx = {s: Signal(intbv(0)[2:]) for s in ("in", "A", "B", "D", "G")}
     insts.append(low2(select_coord, idx["in"]))
-    for s in "ABDF":
+    for s in "ABDG":
         insts.append(low2(sels[s], idx[s]))
-    sa, sb, sc, sd, se, sf, sg = (sels[s] for s in "ABCDEFG")
+    sa, sb, sc, sd, se, sf, sg, sh = (sels[s] for s in "ABCDEFGH")
 
     @always_seq(clk.posedge, reset=rst)
     def select_pipe():
@@ -204,7 +208,8 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
             se.next = sd
             sf.next = se
             sg.next = sf
-            select_coord_out.next = sg
+            sh.next = sg
+            select_coord_out.next = sh
 
     insts.append(select_pipe)
 
@@ -212,7 +217,7 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
     # Multiplier operands are registered (chosen one stage ahead), so each multiplier takes both operands
     # from registers; the addends of the sums are chosen in their own stage and go straight into the
     # adder, where the table and the adder's first level share LUTs.
-    chooser = {8: "in", 10: "in", 7: "in", 9: "in", 6: "B", 5: "B", 4: "B", 3: "D", 2: "D", 1: "F"}
+    chooser = {8: "in", 10: "in", 7: "in", 9: "in", 6: "B", 5: "B", 4: "B", 3: "D", 2: "D", 1: "G"}
     registered = (8, 10, 7, 9, 6)
     cbits, creg = {}, {}
     for i, where in chooser.items():
@@ -253,8 +258,9 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
         fx_mul(reg[21], q(21), xc, q(25), node[17], q(17)),
         fx_add([(reg[15], q(15)), (c3, q(3)), (reg[16], q(16))], node[22], q(22)),
         fx_add([(reg[17], q(17)), (c2, q(2))], node[23], q(23)),
-        fx_mul(reg[22], q(22), ye, q(26), node[18], q(18)),
-        fx_mul(reg[23], q(23), xe, q(25), node[19], q(19)),
+        # registered partial products (stage F), their sums cut into q18 / q19 in stage G
+        fx_mul_reg(clk, enable, reg[22], q(22), ye, q(26), node[18], q(18)),
+        fx_mul_reg(clk, enable, reg[23], q(23), xe, q(25), node[19], q(19)),
         fx_add([(c1, q(1)), (reg[18], q(18)), (reg[19], q(19))], node[24], q(24)),
     ]
     n11, n12, n13, n14, n15, n16, n17, n18, n19, n20, n21, n22, n23, n24 = (node[n] for n in range(11, 25))
@@ -272,14 +278,14 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
         def range_check():
             if r24 < 0:
                 oor.next = 1
-            elif sg[0]:
+            elif sh[0]:
                 oor.next = r24 > lim_y
             else:
                 oor.next = r24 > lim_x
     else:
         @always_comb
         def range_check():
-            if sg[0]:
+            if sh[0]:
                 oor.next = r24 > lim_y
             else:
                 oor.next = r24 > lim_x
@@ -320,12 +326,13 @@ def poly_unit(clk, rst, enable, x, y, select_coord, coord, out_of_range, select_
             r23.next = n23
             xe.next = xd
             ye.next = yd
-            # F
+            # F: the partial products of q18 and q19 (inside fx_mul_reg)
+            # G
             r18.next = n18
             r19.next = n19
-            # G
-            r24.next = n24
             # H
+            r24.next = n24
+            # I
             coord.next = cut
             out_of_range.next = oor
 

@@ -61,7 +61,7 @@ def rectifier(clk, rst, start, fetch, source, busy, coef=None, *, quantizers=Non
             coordinates' fraction bits (default q24's, at most 8 here), as for the warper.
         depth: sides in flight in the fetch/interpolate unit (1..16, default 4).
 
-    Latency: the first beat 24 clocks after ``start`` with an immediate memory (:data:`FIRST_PIXEL`); then
+    Latency: the first beat 26 clocks after ``start`` with an immediate memory (:data:`FIRST_PIXEL`); then
     8 clocks per stereo pixel pair with both sides in range (the two multipliers do four steps per
     side), fewer where a side is black; the memory's wait clocks add where the queue cannot hide them.
 

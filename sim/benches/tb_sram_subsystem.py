@@ -63,6 +63,7 @@ class Controller:
         self.early_release = False
         self.hold = False  # continuous fetching: keep the first pair until the end of the run
         self.fetching = True  # False: nobody takes camera pairs (no fetch traffic)
+        self.wanting = False  # sequential: cam_want raised, the pair not taken yet
 
     def start(self):
         if self.mode == "overlapped":
@@ -84,6 +85,7 @@ class Controller:
             self.fetch.held = True
             self.fetch.start_pass((bufs & 1, bufs >> 1))
             self.takes["cam"] += 1
+            self.wanting = False
             if self.mode == "sequential" or self.early_release:
                 self.pin["cam_want"].set(0)
         self.held["cam"] = bool(cam_held)
@@ -137,13 +139,15 @@ class Controller:
         # sequential mode: arm both cameras when nothing is captured or held
         if self.mode == "sequential" and not self.stopped:
             avail = read_int(d.ctl_avail)
-            if not self.armed_wait and not self.held["cam"] and not self.fetch.held:
+            # (the pair is taken a couple of clocks after cam_want: not held yet is not free yet)
+            if not self.armed_wait and not self.wanting and not self.held["cam"] and not self.fetch.held:
                 self.pin["cam_arm"].set(3)
                 self.arms += 1
                 self.armed_wait = True
             elif self.armed_wait and (avail & 3) == 3:
                 self.pin["cam_want"].set(1)
                 self.armed_wait = False
+                self.wanting = True
 
     pending: list = []
 

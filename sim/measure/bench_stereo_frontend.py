@@ -29,6 +29,7 @@ speed. Every run's report is kept in build/system/runs/ (``--reuse`` takes them 
 
     python -m eyestereo.sim.measure.bench_stereo_frontend [--sim verilator] [--size 352x288] [--frames 2]
         [--small 48x32] [--adaptive-frames 16] [--ghdl-speed 200] [--reuse] [--out docs/system.md]
+    python -m eyestereo.sim.measure.bench_stereo_frontend --single-clock [--size 352x288] [--frames 2] [--frames-ovl 3]
     python -m eyestereo.sim.measure.bench_stereo_frontend --real sequential,overlapped [--real-frames 1]
         [--real-pair LEFT RIGHT] [--real-size 352x288] [--real-threshold 16] [--sim verilator] [--reuse]
 """
@@ -73,9 +74,11 @@ def _kept(tag: str) -> Path:
 
 
 def run_mode(mode: str, size: str, frames: int, timing: dict, sim: str, reuse: bool = False,
-             backend: str | None = None, **extra) -> dict:
-    """One bench run, its report kept in build/system/runs/ (with the wall time and the simulator)."""
-    tag = f"{sim}{'-' + backend if backend else ''}_{mode}_{size}" + ("_speed" if extra.get("speed_us") else "")
+             backend: str | None = None, single_clock: bool = False, **extra) -> dict:
+    """One bench run, its report kept in build/system/runs/ (with the wall time and the simulator);
+    ``single_clock``: the top built with harris_stereo in the memory clock (issue 23's option)."""
+    tag = (f"{sim}{'-' + backend if backend else ''}_{mode}_{size}" + ("_speed" if extra.get("speed_us") else "")
+           + ("_single" if single_clock else ""))
     kept = _kept(tag)
     if reuse and kept.is_file():
         rep = json.loads(kept.read_text())
@@ -89,8 +92,10 @@ def run_mode(mode: str, size: str, frames: int, timing: dict, sim: str, reuse: b
     rep = run_bench("stereo_frontend", "tb_stereo_frontend",
                     dict(dict(mode=mode, frames=frames, images="shift:3", timing=timing, target=200 if full else 40,
                               require_features=not extra.get("speed_us")), **extra),
-                    name=f"bench_{mode}_{size}" + ("_speed" if extra.get("speed_us") else ""), sim=sim,
-                    backend=backend, params=dict(quantizers=f"rig:{size}", feature_words=512, max_features=255),
+                    name=f"bench_{mode}_{size}" + ("_speed" if extra.get("speed_us") else "") +
+                    ("_single" if single_clock else ""), sim=sim, backend=backend,
+                    params=dict(quantizers=f"rig:{size}", feature_words=512, max_features=255,
+                                **(dict(single_clock=True) if single_clock else {})),
                     log_file=RUNS / f"{tag}.log", public=PUBLIC if sim == "verilator" else None)
     # the speed probe's own wall_s is the probe's time alone; the run's (build included) beside it
     rep["wall_total_s" if rep.get("speed") else "wall_s"] = round(time.time() - t0, 1)
@@ -581,6 +586,9 @@ def write_doc(path: Path, *, size: str, figs: dict, small: tuple | None, ghdl: t
     if small is not None:
         lines += small_section(*small, measured=figs if size == "352x288" else None)
     lines += real_section(kept_real())
+    sim = (figs["sequential"].get("simulator") or "").split(" ")[0].lower()
+    two = {m: json.loads(f.read_text()) for m in ("sequential", "overlapped") if (f := _kept(f"{sim}_{m}_{size}")).is_file()}
+    lines += single_section(size, kept_single(size, sim), two) if sim else []
     lines += ghdl_section(*ghdl, figs)
     lines += resources_section()
     lines += demo_section()
@@ -631,6 +639,58 @@ def resources_section() -> list[str]:
                 + ", ".join(f"{names.get(k, k)} {v:.1f} MHz (goal {goals.get(k, '?')})" for k, v in fmax.items())
                 + ".", ""]
     return out
+
+
+SINGLE_TITLE = "## The single-clock build (rectification and Harris in the memory clock)"
+
+
+def kept_single(size: str, sim: str) -> dict[str, dict]:
+    """The single-clock runs of ``size`` kept in build/system/runs/ (mode -> report)."""
+    out = {}
+    for mode in ("sequential", "overlapped"):
+        f = _kept(f"{sim}_{mode}_{size}_single")
+        if f.is_file():
+            out[mode] = json.loads(f.read_text())
+    return out
+
+
+def single_section(size: str, reps: dict[str, dict], two_clock: dict[str, dict]) -> list[str]:
+    """The single-clock build's frames beside the default build's (same bench, same scene)."""
+    if not reps:
+        return []
+    w, h = (int(v) for v in size.split("x"))
+    cam = CameraTiming(width=w, height=h, **timing_of(size))
+    figs = {m: figures(r, cam) for m, r in reps.items()}
+    lines = [SINGLE_TITLE, "",
+             "`stereo_frontend(single_clock=True)`: harris_stereo runs in the memory clock (100 MHz) instead of its own "
+             "50 MHz clock, with no clock-domain crossing for the rectified stream, k, the thresholds and the flags "
+             "(issue 23's build option; `make synth` places it as `stereo_frontend single-clock`). Same bench, scene "
+             f"and host as above, {size}, bit for bit against the same numpy chain:", "", *_mode_rows(figs), ""]
+    if two_clock:
+        tf = {m: figures(r, cam) for m, r in two_clock.items()}
+        lines += ["Against the two-clock build (the table above): " + "; ".join(
+            f"{m} {figs[m]['fps']:.2f} fps (two clocks: {tf[m]['fps']:.2f})" for m in figs if m in tf) + ". "
+            "Overlapped, the cameras set the rate in both builds; sequential, the Harris chain no longer paces the "
+            "rectifier's stream at half the memory clock.", ""]
+    return lines
+
+
+def main_single(args) -> int:
+    """``--single-clock``: both modes on the single-clock top, their section spliced into ``--out``."""
+    sim = args.sim or fastest_simulator()
+    try:
+        timing = timing_of(args.size)
+        reps = {"sequential": run_mode("sequential", args.size, args.frames, timing, sim, args.reuse, single_clock=True),
+                "overlapped": run_mode("overlapped", args.size, args.frames_ovl, timing, sim, args.reuse,
+                                       single_clock=True)}
+    except (AssertionError, RuntimeError) as e:
+        print(f"error: a bench run failed ({str(e).splitlines()[0][:200]})", file=sys.stderr)
+        return 1
+    two = {m: json.loads(f.read_text()) for m in reps if (f := _kept(f"{sim}_{m}_{args.size}")).is_file()}
+    splice_section(args.out, single_section(args.size, reps, two), title=SINGLE_TITLE)
+    print(json.dumps(dict(single_clock=True, size=args.size, simulator=sim,
+                          bit_exact={m: r["bit_exact"] for m, r in reps.items()})))
+    return 0
 
 
 def _size(text: str) -> str:
@@ -691,10 +751,15 @@ def main(argv=None) -> int:
     ap.add_argument("--real-size", type=_size, default="352x288")
     ap.add_argument("--real-threshold", type=int, default=REAL_THRESHOLD,
                     help=f"threshold code of every block (default {REAL_THRESHOLD})")
+    ap.add_argument("--single-clock", action="store_true",
+                    help="only the single-clock build (stereo_frontend(single_clock=True)), both modes at --size "
+                         "(--frames, --frames-ovl); its section of --out is replaced in place")
     ap.add_argument("--reuse", action="store_true", help="take the runs' reports from build/system/runs/ if there")
     args = ap.parse_args(argv)
     if args.real is not None:
         return main_real(args)
+    if args.single_clock:
+        return main_single(args)
     if args.frames < 1 or args.frames_ovl < 1:
         print("error: --frames and --frames-ovl must be at least 1", file=sys.stderr)
         return 1

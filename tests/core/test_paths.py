@@ -236,6 +236,24 @@ def test_goal_table_and_paths_section():
     assert "prethreshold" not in s.split("|---", 1)[1]  # met with the margin: no row
 
 
+def test_goal_table_shows_the_figures_before_and_the_spartan3e_fit():
+    before = {"stereo_frontend": dict(LUT=5000, LUTRAM=200, FF=6000, RAMB16=16, MULT18X18=19,
+                                      fmax={"clk": 76.1, "hclk": 86.3})}
+    fe = dict(label="stereo_frontend", block="stereo_frontend", clocks={"clk": 100.0, "hclk": 50.0}, seeds=[1],
+              fmax={"clk": dict(achieved=111.0, min=111.0, median=111.0, max=111.0, per_seed={1: 111.0}),
+                    "hclk": dict(achieved=120.0, min=120.0, median=120.0, max=120.0, per_seed={1: 120.0})},
+              summary=dict(LUT=5400, LUTRAM=300, FF=6500, RAMB16=17, MULT18X18=19))
+    big = dict(fe, label="stereo_frontend single-clock", summary=dict(LUT=9000, LUTRAM=400, FF=6500, RAMB16=17,
+                                                                      MULT18X18=19))
+    t = goals_table([fe, big], before)
+    assert "| stereo_frontend | clk | 100 (memory clock) | 111.0 / 111.0 / 111.0 | +11.0 % | yes | - | 76.1 |" in t
+    # 5700 LUTs against 5200 before: +9.6 %, within 10 %; the single-clock row compares with the same figures
+    assert "| stereo_frontend | 5400 + 300 = 5700 of 9312 | 6500 of 9312 | 17 of 20 | 19 of 20 | yes | 5000 + 200 | " \
+           "+9.6 % | yes |" in t
+    assert "| stereo_frontend single-clock | 9000 + 400 = 9400 of 9312 | 6500 of 9312 | 17 of 20 | 19 of 20 | **no** | " \
+           "5000 + 200 | +80.8 % | **no** |" in t
+
+
 def test_seeds_option():
     assert parse_seeds("1,2,3,4") == [1, 2, 3, 4] and parse_seeds("1") == [1]
     for bad in ("", "0", "1,1", "a"):

@@ -51,8 +51,8 @@ def test_warper_at_once_is_four_clocks_per_pair(request):
     rep = _run(request, dict(quantizers="seed:8@40x20", batch=8), frames=3, seed=8)
     assert rep["clocks_per_pair"] < 4.0 + 40 / (3 * 40 * 20)  # 4 per pair; the frame gaps add a little
     n = 40 * 20
-    # first pair offered 13 clocks after the start clock, taken in that clock; done 1 clock after the last
-    assert rep["frame_clocks"] == [4 * n + 10] * 3
+    # first pair offered 14 clocks after the start clock, taken in that clock; done 1 clock after the last
+    assert rep["frame_clocks"] == [4 * n + 11] * 3
 
 
 def test_warper_reset_and_start_while_busy(request):

@@ -97,3 +97,21 @@ def test_block_with_more_ports_than_pins_is_placed_out_of_context(tmp_path):
     assert r["ecp5"]["TRELLIS_FF"] == r["summary"]["FF"], (r["ecp5"], r["summary"])
     md = table([r])
     assert "(out of context)" in md and "Placed out of context" in md
+
+
+def test_merged_runs_keep_report_order_and_the_later_result(tmp_path):
+    from eyestereo.hdl.flow.synth import merge_input, merge_results
+
+    first = [dict(label="sobel", lut=1), dict(label="line_delay", lut=2)]
+    second = [dict(label="sobel", lut=3), dict(label="stereo_frontend single-clock", lut=4)]
+    got = merge_results([first, second])
+    assert [r["label"] for r in got] == ["line_delay", "sobel", "stereo_frontend single-clock"]
+    assert [r["lut"] for r in got] == [2, 3, 4]
+    with pytest.raises(ValueError, match="no longer has: gone"):
+        merge_results([[dict(label="gone")]])
+    bad = tmp_path / "r.json"
+    bad.write_text('{"label": 1}')
+    with pytest.raises(ValueError, match="not a resources.json of make synth"):
+        merge_input(bad)
+    with pytest.raises(ValueError, match="not a readable resources.json"):
+        merge_input(tmp_path / "missing.json")

@@ -41,8 +41,9 @@ __all__ = ["DEFAULT_FRAC", "LATENCY", "SELECT", "VALID", "Calibration", "coef_ad
            "register_writes", "resolve_frac"]
 
 #: Pipeline depth of the hardware unit: input register, the six arithmetic stages of the levelized
-#: listing (products, sums, products, sums, products, output sum), and the range check / cut.
-LATENCY = 8
+#: listing (products, sums, products, sums, products, output sum) with the last products over two
+#: stages (partial products, then their sum), and the range check / cut.
+LATENCY = 9
 #: Default fraction bits of the output coordinate: ``None`` = q24's own fraction length (clamped to
 #: 0..MAX_FRAC), which the interpolation study (docs/rectifier.md) picks on every calibration: fewer bits
 #: add error, more add only zeros. The synthetic rig (352x288) gets 5, the OpenCV calibration (640x480) 6.
