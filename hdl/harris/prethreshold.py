@@ -211,8 +211,9 @@ def camera_tables(clk, rst, sink, source, value, thr_we, thr_addr, thr_data, ahe
         stored_r.next = mem_r[ahead]
 
 
-    return [write_check(thr_we, thr_addr, we, limit=2 * nblk), split, ram, written_flags(clk, rst, we, thr_addr, written),
-            camera_due, camera, read, entry_register(clk, rst, written, raddr_l, stored_l, thr_l),
+    return [write_check(thr_we, thr_addr, we, limit=2 * nblk), split, ram,
+            written_flags(clk, rst, we, thr_addr, written), camera_due, camera, read,
+            entry_register(clk, rst, written, raddr_l, stored_l, thr_l),
             entry_register(clk, rst, written, raddr_r, stored_r, thr_r),
             pass_greater(clk, rst, sink, source, value, thr_l, thr_r, due)]
 
