@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from myhdl import Signal, always_comb, always_seq, block, concat, intbv
+from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv
 
 from eyestereo.hdl.streaming.async_fifo import MAX_DEPTH
 from eyestereo.hdl.interfaces.axil import check_axil
@@ -34,18 +34,23 @@ from eyestereo.tools.constants import NMS_DEFAULT, NMS_SIZES, THRESHOLD_BLOCKS
 from eyestereo.tools.regmap import REGMAP
 from eyestereo.tools.sram import KINDS
 
-__all__ = ["stereo_frontend", "BLOCKS", "THR_BITS"]
+__all__ = ["stereo_frontend", "BLOCKS", "CAM_DEPTH", "THR_BITS"]
 
 #: Threshold blocks per camera (:data:`eyestereo.tools.constants.THRESHOLD_BLOCKS`): the register map's 16
 #: thresholds and 32 per-block counts.
 BLOCKS = THRESHOLD_BLOCKS
 THR_BITS = REGMAP["THR_LEFT"].fields[0].width
+#: Each camera FIFO's default depth. The arbiter serves the cameras first (urgent writers): at every camera
+#: rate the SRAM sustains, the FIFO held at most 2 words (docs/sram.md), so 32 leave room for the crossing
+#: and the bursts. In LUT-RAM, the read side's word comes from a flip-flop; from a block RAM it came 5.8 ns
+#: after the clock edge, and the FIFO's frame logic behind it was the memory clock's slowest path (issue 23).
+CAM_DEPTH = 32
 
 
 @block
 def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sram, *, quantizers="rig",
                     frac: int | None = unit_model.DEFAULT_FRAC, nms: int = NMS_DEFAULT, border: int | None = None,
-                    max_features: int = 1023, feature_words: int = 2048, cam_depth: int = 1024,
+                    max_features: int = 1023, feature_words: int = 2048, cam_depth: int = CAM_DEPTH,
                     kind: str = "nobl", read_latency: int = 2, order: str = "YUYV", rect_depth: int = DEFAULT_DEPTH,
                     single_clock: bool = False):
     """The complete stereo front end of the thesis's Fig. 7.2, with the processor's register bus.
@@ -87,7 +92,7 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
             every 2 Harris clocks with no back-pressure, which only share 1 (a beat per clock) takes.
         border: feature_list's border (default harris_stereo's r = 3 + nms // 2).
         max_features, feature_words: features per list and the SRAM words of each list buffer.
-        cam_depth: each camera FIFO's entries (1024 = one RAMB16).
+        cam_depth: each camera FIFO's entries (default :data:`CAM_DEPTH` = 32, LUT-RAM; 1024 = one RAMB16).
         kind, read_latency: the SRAM part (sram_controller).
         order: the cameras' byte order.
         rect_depth: fetch_interpolate's sides in flight.
@@ -216,7 +221,24 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     cb = count_bits(width, height)
     c_addr = Signal(intbv(0)[addr_bits(BLOCKS):])
     c_data, tot_l, tot_r = Signal(intbv(0)[cb:]), Signal(intbv(0)[cb:]), Signal(intbv(0)[cb:])
-    insts.append(feature_list(clk, rst, flags, feat, c_addr, c_data, tot_l, tot_r, l_ovf, l_done, width=width,
+    # The flags beat into the feature list from registers beside it: the list reads its counter a clock ahead
+    # from the beat's camera and block, and from the crossing's FIFO (or the Harris chain) that path was the
+    # memory clock's slowest (issue 23). One clock more to each list's end.
+    list_in = ImageStream(1, stereo=True)
+
+    @always_seq(clk.posedge, reset=rst)
+    def to_list_valid():
+        list_in.valid.next = flags.valid
+
+    @always(clk.posedge)
+    def to_list_beat():
+        list_in.data.next = flags.data
+        list_in.cam.next = flags.cam
+        list_in.eol.next = flags.eol
+        list_in.eof.next = flags.eof
+
+    insts += [to_list_valid, to_list_beat]
+    insts.append(feature_list(clk, rst, list_in, feat, c_addr, c_data, tot_l, tot_r, l_ovf, l_done, width=width,
                               height=height, blocks=BLOCKS, border=border, max_features=max_features))
     c_reg = Signal(intbv(0)[16:])
     top = (1 << 16) - 1

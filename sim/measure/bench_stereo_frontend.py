@@ -44,6 +44,7 @@ import sys
 import time
 from pathlib import Path
 
+from eyestereo.hdl.system.stereo_frontend import CAM_DEPTH
 from eyestereo.sim.apps.cli_system import frame_size
 from eyestereo.sim.lib.frontend_runs import CLOCKS, PUBLIC, SHORT_BLANKING, figures
 from eyestereo.sim.lib.runner import ROOT, fastest_simulator, hdl_revision, revision_note, run_bench
@@ -620,7 +621,7 @@ def resources_section() -> list[str]:
     used = dict(LUT=luts, FF=s["FF"], RAMB16=s["RAMB16"], MULT18X18=s["MULT18X18"])
     out += ["`python -m eyestereo.hdl.flow.synth --block stereo_frontend --no-pnr`: GHDL's synthesis of the generated VHDL "
             "(the default top: 352x288 cameras, the synthetic rig's calibration, harris_stereo share 1, nms 3, "
-            "1024-word camera FIFOs), Yosys `synth_xilinx -family xc3se`, not placed" +
+            f"{CAM_DEPTH}-word camera FIFOs), Yosys `synth_xilinx -family xc3se`, not placed" +
             ("" if rows else " (figures of the last run; build/synth/resources.json not present)") + ".", "",
             "| resource | used | Spartan-3E 500 | share | margin |", "|---|---:|---:|---:|---:|"]
     for k, cap in DEVICE.items():
