@@ -3,7 +3,7 @@
 from myhdl import block
 
 from eyestereo.hdl.streaming.async_fifo import async_fifo
-from eyestereo.hdl.streaming.async_fifo import check_depth
+from eyestereo.hdl.streaming.async_fifo import DEFAULT_DEPTH, check_depth
 from eyestereo.hdl.camera.camera_stream import camera_stream, check_camera, check_camera_params
 from eyestereo.hdl.common.checks import check_clock, check_reset, check_signal
 from eyestereo.hdl.interfaces.queue import check_queue
@@ -13,7 +13,8 @@ from eyestereo.tools.camera import WORD
 
 @block
 def camera_interface(cam, wrst, rclk, rrst, source, dropped, *, width: int = 352, height: int = 288,
-                     order: str = "YUYV", vsync_active: int = 1, href_active: int = 1, depth: int = 1024):
+                     order: str = "YUYV", vsync_active: int = 1, href_active: int = 1,
+                     depth: int = DEFAULT_DEPTH):
     """One camera into the system clock: :func:`~eyestereo.hdl.camera.camera_stream.camera_stream` in the camera's
     clock, then :func:`~eyestereo.hdl.streaming.async_fifo.async_fifo` into ``rclk``.
 
@@ -36,13 +37,14 @@ def camera_interface(cam, wrst, rclk, rrst, source, dropped, *, width: int = 352
 
     Parameters:
         width, height, order, vsync_active, href_active: of camera_stream (the camera's geometry and bus).
-        depth: FIFO entries (power of two; 1024 = one RAMB16, absorbs a reader stall of 135 us at the
-            OV6630's 9 M words/s: see docs/camera.md).
+        depth: FIFO entries (power of two; default 32 in LUT-RAM, absorbs a reader stall of 3.5 us at the
+            OV6630's 9 M words/s; 1024 = one RAMB16, 135 us, with a slower read clock: async_fifo's
+            ``DEFAULT_DEPTH``; see docs/camera.md).
 
     Latency: camera_stream's 1 PCLK, one PCLK into the FIFO, then three ``rclk`` edges (synchroniser and
     block RAM read) when the FIFO is empty and the reader ready.
 
-    Resources: camera_stream plus async_fifo: one RAMB16 at the default depth.
+    Resources: camera_stream plus async_fifo: LUT-RAM at the default depth, one RAMB16 at 1024.
     """
     check_camera("cam", cam)
     check_reset(wrst, "wrst")
@@ -63,7 +65,7 @@ def camera_interface(cam, wrst, rclk, rrst, source, dropped, *, width: int = 352
 @block
 def camera_pair(cam_l, wrst_l, cam_r, wrst_r, rclk, rrst, source_l, source_r, dropped_l, dropped_r, *,
                 width: int = 352, height: int = 288, order: str = "YUYV", vsync_active: int = 1,
-                href_active: int = 1, depth: int = 1024):
+                href_active: int = 1, depth: int = DEFAULT_DEPTH):
     """Two cameras, each with its own clock and reset, into one system clock: two
     :func:`camera_interface` blocks side by side (the thesis's stereo rig, Fig. 7.2).
 

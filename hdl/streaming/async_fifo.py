@@ -7,6 +7,12 @@ from eyestereo.hdl.common.checks import block_error, check_clock, check_int, che
 from eyestereo.hdl.interfaces.queue import check_queue
 
 MAX_DEPTH = 1 << 14
+#: The default depth: LUT-RAM, so that the read side's word comes from a flip-flop. A block RAM (1024 x 18 in
+#: one RAMB16) gives its word 5.8 ns after the clock edge on the ECP5, in front of the read side's frame
+#: logic: make synth measured the read clock at 104.9 / 116.5 / 119.4 MHz (min / median / max over seeds
+#: 1-4) with depth 1024, below the memory clock's 110 MHz (issue 23); 32 words hold what the front end's
+#: arbiter ever leaves in a camera FIFO (at most 2, docs/sram.md). Take 1024 for a reader that stalls.
+DEFAULT_DEPTH = 32
 
 
 def check_depth(depth) -> int:
@@ -18,7 +24,8 @@ def check_depth(depth) -> int:
 
 
 @block
-def async_fifo(wclk, wrst, sink, rclk, rrst, source, dropped, full=None, empty=None, *, depth: int = 1024):
+def async_fifo(wclk, wrst, sink, rclk, rrst, source, dropped, full=None, empty=None, *,
+               depth: int = DEFAULT_DEPTH):
     """Carry an image stream from the write clock into the read clock; deliver whole frames or abort them.
 
     The memory is ``depth`` entries of ``data + eol + eof`` (18 bits for camera words: one Spartan-3E
@@ -71,7 +78,8 @@ def async_fifo(wclk, wrst, sink, rclk, rrst, source, dropped, full=None, empty=N
         empty: optional output, read clock: nothing to load (the output register may still hold a word).
 
     Parameters:
-        depth: entries, a power of two in 4..16384 (1024: one RAMB16 at 18 bits).
+        depth: entries, a power of two in 4..16384 (default :data:`DEFAULT_DEPTH` = 32, LUT-RAM; 1024: one
+            RAMB16 at 18 bits, with a slower read side: see :data:`DEFAULT_DEPTH`).
 
     Latency: a word written at a write edge is presented from the third read edge after it on (two
     synchroniser flops and the registered read), more if the output register is occupied. A read is

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from myhdl import Signal, always, always_comb, always_seq, block, concat, intbv
 
+from eyestereo.hdl.streaming.async_fifo import DEFAULT_DEPTH as FIFO_DEPTH
 from eyestereo.hdl.streaming.async_fifo import MAX_DEPTH
 from eyestereo.hdl.interfaces.axil import check_axil
 from eyestereo.hdl.camera.camera_stream import check_camera
@@ -40,11 +41,12 @@ __all__ = ["stereo_frontend", "BLOCKS", "CAM_DEPTH", "THR_BITS"]
 #: thresholds and 32 per-block counts.
 BLOCKS = THRESHOLD_BLOCKS
 THR_BITS = REGMAP["THR_LEFT"].fields[0].width
-#: Each camera FIFO's default depth. The arbiter serves the cameras first (urgent writers): at every camera
-#: rate the SRAM sustains, the FIFO held at most 2 words (docs/sram.md), so 32 leave room for the crossing
-#: and the bursts. In LUT-RAM, the read side's word comes from a flip-flop; from a block RAM it came 5.8 ns
-#: after the clock edge, and the FIFO's frame logic behind it was the memory clock's slowest path (issue 23).
-CAM_DEPTH = 32
+#: Each camera FIFO's default depth (async_fifo's): the arbiter serves the cameras first (urgent writers):
+#: at every camera rate the SRAM sustains, the FIFO held at most 2 words (docs/sram.md), so 32 leave room for
+#: the crossing and the bursts. In LUT-RAM, the read side's word comes from a flip-flop; from a block RAM it
+#: came 5.8 ns after the clock edge, and the FIFO's frame logic behind it was the memory clock's slowest path
+#: (issue 23).
+CAM_DEPTH = FIFO_DEPTH
 
 
 @block

@@ -98,6 +98,8 @@ async def fetch_interpolate_pairs(dut):
     eof = np.zeros((frames, h, w), dtype=np.int64)
     eof[:, -1, -1] = 1
     pairs["eol"], pairs["eof"] = eol.ravel(), eof.ravel()
+    if cfg.get("first_in_range"):  # the first pair's sides both fetched: its latency is FIRST_PIXEL's
+        pairs["oor_l"][0] = pairs["oor_r"][0] = 0
     left = rng.integers(0, 256, (sh, sw), dtype=np.uint8)
     right = rng.integers(0, 256, (sh, sw), dtype=np.uint8)
 
@@ -124,4 +126,6 @@ async def fetch_interpolate_pairs(dut):
     masks = mem.request_arrays()["mask"]
     kinds = sorted({int(m) for m in masks})
     write_report(cfg, dict(pairs=n, beats=len(mon.beats), requests=len(mem.requests), reads=mem.reads,
-                           masks=kinds, clocks=loop.clock, black=int(pairs["oor_l"].sum() + pairs["oor_r"].sum())))
+                           masks=kinds, clocks=loop.clock, black=int(pairs["oor_l"].sum() + pairs["oor_r"].sum()),
+                           first_pixel=mon.clocks[0] - src.taken_clocks[0],
+                           first_in_range=bool(not pairs["oor_l"][0])))

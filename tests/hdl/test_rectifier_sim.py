@@ -31,9 +31,13 @@ def test_fetch_interpolate(request, case):
     mem, frac, depth, offer_p, oor_p = FI_CASES[case]
     seed = sorted(FI_CASES).index(case) + 21
     rep = run_bench("fetch_interpolate", "tb_fetch_interpolate",
-                    dict(mem, seed=seed, width=24, height=8, frames=2, offer_p=offer_p, oor_p=oor_p),
+                    dict(mem, seed=seed, width=24, height=8, frames=2, offer_p=offer_p, oor_p=oor_p,
+                         first_in_range=case == "at_once"),
                     name=request.node.name, params=dict(quantizers="seed:3:2@40x20", frac=frac, depth=depth))
     assert rep["beats"] == 2 * rep["pairs"] and rep["black"] > 0
+    if case == "at_once":
+        # the documented latency (fetch_interpolate.FIRST_PIXEL): the first pixel 12 clocks after its pair
+        assert rep["first_in_range"] and rep["first_pixel"] == 12
     # every non-empty mask of the reuse rule and the full one came up
     assert set(rep["masks"]) == {3, 5, 7, 10, 11, 12, 13, 14, 15}
 
