@@ -79,9 +79,9 @@ def harris_stereo(clk, rst, sink, source, k_left, k_right, thr_we, thr_cam, thr_
 
     Resources: stereo line delays: 2 Sobel (1 RAMB16 each), 4 window (2 each), 1 NMS 3x3 (2) -- 12
     RAMB16 at 352 wide for nms 3; :func:`multipliers` MULT18X18. Measured (make synth's flow, Yosys
-    xc3se, 352x288, 4x4, nms 3): share 3: 1539 LUT + 40 LUT-RAM, 2023 FF, 12 RAMB16, 3 MULT18X18, 85 MHz
-    on ECP5 (thesis Table 6.4: 3473 LUT, 12, 3); share 2: 1526 / 12 / 4; share 1: 1464 / 12 / 7;
-    per module in docs/harris_stereo.md.
+    xc3se, 352x288, 4x4, nms 3): share 3: 1412 LUT + 40 LUT-RAM, 2133 FF, 12 RAMB16, 3 MULT18X18, 114.3 MHz
+    on ECP5, the slowest of nextpnr seeds 1-4 (thesis Table 6.4: 3473 LUT, 12, 3); before issue 23's
+    re-pipelining share 2: 1526 / 12 / 4, share 1: 1464 / 12 / 7; per module in docs/harris_stereo.md.
     """
     nb = corner_model.OUT.wl
     check_clock(clk)
