@@ -35,7 +35,8 @@ import numpy as np
 from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_MAX, FRAME_MIN, FRAME_WIDTH
 from eyestereo.tools.packed import PackedWord
 
-__all__ = ["WORD", "ORDERS", "CameraTiming", "DEFAULT_TIMING", "yuv_frame", "line_bytes", "frame_schedule", "cut",
+__all__ = ["WORD", "ORDERS", "CameraTiming", "DEFAULT_TIMING", "VGA_TIMING", "CIF_PCLK_HZ", "VGA_PCLK_HZ", "yuv_frame",
+           "line_bytes", "frame_schedule", "cut",
            "schedule_length", "vsyncs_before", "Fault"]
 
 #: One camera word per pixel: Y in bits 7..0, the chroma sample (U for even x, V for odd x) in 15..8.
@@ -125,6 +126,11 @@ class CameraTiming:
 
 #: The default timing (CIF, the OV6630's): one instance, the default of every function that takes a timing.
 DEFAULT_TIMING = CameraTiming()
+#: An OV7670-class camera at VGA (its data sheet's VGA frame: 784 pixel times a line, 510 lines: VSYNC 3, 17
+#: before the first line, 480, 10 after): 30 frames/s at a 24 MHz PCLK (two PCLK per pixel).
+VGA_TIMING = CameraTiming(width=640, height=480, h_blank=2 * (784 - 640), v_sync=3, v_back=17, v_front=10)
+#: The pixel clocks of the two timings (Hz).
+CIF_PCLK_HZ, VGA_PCLK_HZ = 17.73e6, 24e6
 
 
 def yuv_frame(y, u=128, v=128) -> np.ndarray:

@@ -43,6 +43,11 @@ from eyestereo.hdl.rectify.fetch_interpolate import fetch_interpolate
 from eyestereo.hdl.streaming.line_delay import line_delay
 from eyestereo.hdl.rectify.poly_unit import CoefPort, poly_unit
 from eyestereo.hdl.rectify.rectifier import rectifier
+from eyestereo.hdl.rectify.line_cache import line_cache
+from eyestereo.hdl.memory.sdram_controller import sdram_controller
+from eyestereo.hdl.interfaces.sdram_bus import SdramPins, SdramPort
+from eyestereo.tools.sdram import part as sdram_part
+from eyestereo.hdl.rectify.stream_rectifier import stream_rectifier
 from eyestereo.hdl.rectify.calibration import calibration_of
 from eyestereo.hdl.system.stereo_frontend import stereo_frontend
 from eyestereo.hdl.harris.sobel import sobel
@@ -292,6 +297,21 @@ def _build_rectifier(p):
                        source=ImageStream(8, stereo=True), busy=_bit(p), **_coef_port(p, cal))
 
 
+def _build_line_cache(p):
+    return fresh_ports(line_cache, cam0=QueuePort(CAMERA_WORD), cam1=QueuePort(CAMERA_WORD),
+                       fetch=FetchPort(p["width"], p["height"]), start=_bit(p), run=_bit(p), arm=_bit(p),
+                       begun=_bit(p),
+                       overrun=_bit(p))
+
+
+def _build_stream_rectifier(p):
+    cal = calibration(p)
+    return fresh_ports(stream_rectifier, cam0=QueuePort(CAMERA_WORD), cam1=QueuePort(CAMERA_WORD),
+                       source=ImageStream(8, stereo=True), start=_bit(p), arm=_bit(p), begun=_bit(p), busy=_bit(p),
+                       overrun=_bit(p),
+                       **_coef_port(p, cal))
+
+
 def _build_feature_list(p):
     cb = count_bits(p["width"], p["height"])
     return fresh_ports(feature_list, sink=ImageStream(1, stereo=True), source=QueuePort(16),
@@ -341,6 +361,12 @@ BLOCKS: dict[str, BlockSpec] = {b.name: b for b in (
           source_width=_fixed(8), build=_build_fetch_interpolate),
     block("rectifier", "coordinate_warper + fetch_interpolate: calibration in, rectified 8-bit stereo stream out",
           rectifier, differ=POLY_DEFAULTS, source_width=_fixed(8), build=_build_rectifier),
+    block("line_cache", "the last L lines of both cameras in block RAM behind a fetch port (rectify='stream')",
+          line_cache, sink_width=_fixed(16),
+          source_width=_fixed(8), build=_build_line_cache),
+    block("stream_rectifier", "line_cache + rectifier: the cameras' streams in, the rectified stereo stream out, "
+          "no frame store", stream_rectifier, differ=POLY_DEFAULTS, sink_width=_fixed(16), source_width=_fixed(8),
+          build=_build_stream_rectifier),
     block("harris_mono", "Harris corners: Sobel -> window -> cornerness -> pre-threshold -> NMS", harris_mono,
           sink_width=_fixed(8), source_width=_fixed(nms_model.WORD.width), control=(("k", k_port),) + thr_ports()),
     # share 3 is stated, whatever the block's default: the catalogue's configuration is the thesis's
@@ -379,6 +405,12 @@ BLOCKS: dict[str, BlockSpec] = {b.name: b for b in (
 )}
 
 
+def _build_sdram_controller(p):
+    part = sdram_part(p["part"])
+    return fresh_ports(sdram_controller, port=SdramPort(part.addr_bits, p["max_burst"], part.data_bits),
+                       pins=SdramPins(part))
+
+
 # --- the SRAM subsystem (issue 12): blocks with interfaces of their own, ports made by ``build`` --------
 def masters(p):
     """Fresh ports of the six SRAM masters (and the frame handshake and status port) for ``p``'s frame."""
@@ -401,6 +433,9 @@ for _b in (
           sram_arbiter, sink_width=_fixed(16), source_width=_fixed(8),
           build=lambda p: fresh_ports(sram_arbiter, **masters(p), cmd=SramCmd(tag_bits=TAG_BITS),
                                       rsp=SramRsp(tag_bits=TAG_BITS)), clocks=_CLOCK_100),
+    block("sdram_controller", "SDR SDRAM (the ULX3S's AS4C32M16SB): pins <-> in-order burst port, open rows, "
+          "bank interleaving, auto refresh", sdram_controller, sink_width=_fixed(16), source_width=_fixed(16),
+          build=_build_sdram_controller, clocks=_CLOCK_100),
     block("sram_subsystem", "sram_arbiter + sram_controller: the SRAM's pins and the six masters' ports",
           sram_subsystem, sink_width=_fixed(16), source_width=_fixed(8),
           build=lambda p: fresh_ports(sram_subsystem, **masters(p), sram=SramPins()), clocks=_CLOCK_100),

@@ -75,7 +75,7 @@ CLOCK_GOALS = {
     **{b: 50.0 for b in ("line_delay", "convolve", "sobel", "harris_window", "cornerness", "prethreshold",
                          "nms", "harris_mono", "harris_stereo", "feature_list")},
     **{b: 100.0 for b in ("poly_unit", "coordinate_warper", "fetch_interpolate", "rectifier",
-                          "sram_controller", "sram_arbiter")},
+                          "sram_controller", "sram_arbiter", "line_cache", "stream_rectifier", "sdram_controller")},
 }
 #: The thesis's own fmax figures (MHz) where it gives one: ISE's estimate for the mono Harris, "no
 #: matter which kind of non-maximum suppression" (6.2.5).
@@ -97,6 +97,10 @@ VARIANTS = [
     ("stream_checker stereo repair", "stream_checker", dict(stereo=True, repair=True)),
     # Issue 23: rectification and Harris in the one memory clock (no hclk, no CDCs); its clk goal is that clock's.
     ("stereo_frontend single-clock", "stereo_frontend", dict(single_clock=True)),
+    # Issue 26: rectify="stream" for the OpenCV calibration at CIF and at VGA (its own 640x480, 64 lines)
+    ("stream_rectifier opencv@352x288", "stream_rectifier", dict(quantizers="opencv@352x288")),
+    ("stream_rectifier opencv 640x480", "stream_rectifier", dict(quantizers="opencv")),
+    ("stream_rectifier rig:640x480", "stream_rectifier", dict(quantizers="rig:640x480")),
 ]
 #: Clock ports a variant leaves unused (no goal row for them): the single-clock front end has no Harris clock.
 UNUSED_CLOCKS = {"stereo_frontend single-clock": ("hclk",)}

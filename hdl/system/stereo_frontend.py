@@ -21,6 +21,7 @@ from eyestereo.hdl.harris.harris_stereo import harris_stereo
 from eyestereo.hdl.rectify.calibration import calibration_param
 from eyestereo.hdl.interfaces.queue import QueuePort
 from eyestereo.hdl.rectify.rectifier import rectifier
+from eyestereo.hdl.rectify.stream_rectifier import stream_rectifier
 from eyestereo.hdl.system.register_bank import RegisterPorts, register_bank
 from eyestereo.hdl.interfaces.sram_bus import HostPort, SramPins, StatPort, check_bundle
 from eyestereo.hdl.memory.sram_subsystem import sram_subsystem
@@ -35,7 +36,10 @@ from eyestereo.tools.constants import NMS_DEFAULT, NMS_SIZES, THRESHOLD_BLOCKS
 from eyestereo.tools.regmap import REGMAP
 from eyestereo.tools.sram import KINDS
 
-__all__ = ["stereo_frontend", "BLOCKS", "CAM_DEPTH", "THR_BITS"]
+__all__ = ["stereo_frontend", "BLOCKS", "CAM_DEPTH", "RECTIFY", "THR_BITS"]
+
+#: The rectification choices: from the frame store (the thesis's) or from an on-chip line cache.
+RECTIFY = ("fetch", "stream")
 
 #: Threshold blocks per camera (:data:`eyestereo.tools.constants.THRESHOLD_BLOCKS`): the register map's 16
 #: thresholds and 32 per-block counts.
@@ -54,7 +58,7 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
                     frac: int | None = unit_model.DEFAULT_FRAC, nms: int = NMS_DEFAULT, border: int | None = None,
                     max_features: int = 1023, feature_words: int = 2048, cam_depth: int = CAM_DEPTH,
                     kind: str = "nobl", read_latency: int = 2, order: str = "YUYV", rect_depth: int = DEFAULT_DEPTH,
-                    single_clock: bool = False):
+                    single_clock: bool = False, rectify: str = "fetch", cache_lines: int | None = None):
     """The complete stereo front end of the thesis's Fig. 7.2, with the processor's register bus.
 
     Data flow: each camera bus -> :func:`~eyestereo.hdl.camera.camera_interface.camera_pair` (converter and
@@ -102,6 +106,17 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
             thresholds and the flags cross through stream_cdc / word_cdc; True: harris_stereo in the memory
             clock, wired straight (no crossings, HARRIS_OVF stays 0; the whole Harris chain must then meet
             the memory clock: docs/benchmarks.md).
+        rectify: ``"fetch"`` (default, the thesis's): the camera frames go into their SRAM double buffers and the
+            rectifier fetches its 2x2 neighbourhoods from there (about 1.9 reads per pixel); ``"stream"``: the
+            cameras' words go straight into :func:`~eyestereo.hdl.rectify.stream_rectifier.stream_rectifier` (a
+            line cache of ``cache_lines`` lines per camera in block RAM), which rectifies each frame as it
+            arrives: no camera frames and no rectifier reads in the SRAM, the camera buffers stay empty. The
+            sequencer's modes are the same: a stereo frame is "held" when both cameras have begun one (the
+            sequential mode's arming waits for frames that begin after it); a frame whose lines the cameras
+            overwrote before the rectifier read them (the cache too small, or the cameras too far apart) still
+            runs through and is counted in both DROPPED registers.
+        cache_lines: the line cache's lines per camera (``rectify="stream"``); default: the calibration's plan
+            (:func:`eyestereo.tools.models.line_cache.plan`).
 
     Latency: a frame's features are complete a few lines (Harris's lead, :func:`harris_stereo.latency`)
     after the rectifier's last beat; the sequencer's ``frame_clocks`` measures the whole.
@@ -141,6 +156,10 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     rect_depth = check_int("rect_depth", rect_depth, 1, 16)
     if frac is not None:
         frac = check_int("frac", frac, 0, unit_model.MAX_FRAC)
+    rectify = check_choice("rectify", rectify, RECTIFY)
+    stream = rectify == "stream"
+    if cache_lines is not None and not stream:
+        raise block_error("parameter cache_lines is for rectify='stream' (the line cache)")
 
     insts = []
     # ---- cameras into the memory clock ---------------------------------------------------------
@@ -152,6 +171,9 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     # the camera FIFOs' words come from block RAM: the camera writers' logic starts at flip-flops (issue 23:
     # the block RAM's clock-to-output into the writer was the memory clock's critical path)
     insts += [queue_slice(clk, rst, fifo0, cam0), queue_slice(clk, rst, fifo1, cam1)]
+    # rectify="stream": the cameras' words go to the line cache; the SRAM's camera writers and fetch port idle
+    # (their inputs undriven: constant 0, no frame comes, no request)
+    m_cam0, m_cam1 = (QueuePort(CAMERA_WORD), QueuePort(CAMERA_WORD)) if stream else (cam0, cam1)
 
     # ---- SRAM subsystem and register bank --------------------------------------------------------
     fetch = FetchPort(width, height)
@@ -160,15 +182,39 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     host, stat, ctl = HostPort(), StatPort(), FrameControl()
     fcount = StatPort(5, 16)
     regs = RegisterPorts()
-    insts.append(sram_subsystem(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, sram, kind=kind,
+    insts.append(sram_subsystem(clk, rst, m_cam0, m_cam1, fetch, rect, feat, host, ctl, stat, sram, kind=kind,
                                 read_latency=read_latency, width=width, height=height, feature_words=feature_words))
     insts.append(register_bank(clk, rst, bus, regs, stat, fcount, host, width=width, height=height))
 
     # ---- rectifier and sequencer -----------------------------------------------------------------
     r_start, r_busy = Signal(bool(0)), Signal(bool(0))
-    insts.append(rectifier(clk, rst, r_start, fetch, rect, r_busy, quantizers=cal, frac=frac, depth=rect_depth))
+    top = (1 << 16) - 1
+    overrun = Signal(bool(0))
+    overruns = Signal(intbv(0)[16:])
+    if stream:
+        # the sequencer's camera handshake: a pair is "held" when both cameras have begun a frame
+        sctl = FrameControl()
+        s_arm, s_begun = Signal(bool(0)), Signal(bool(0))
+        insts.append(stream_rectifier(clk, rst, cam0, cam1, rect, r_start, s_arm, s_begun, r_busy, overrun,
+                                      quantizers=cal, frac=frac, lines=cache_lines, depth=rect_depth))
+
+        @always_comb
+        def stream_handshake():
+            # begun is a register the arm pulse clears a clock later: a pair begun before the arming is not held
+            sctl.cam_held.next = s_begun and sctl.cam_arm == 0
+            s_arm.next = sctl.cam_arm != 0
+
+        @always_seq(clk.posedge, reset=rst)
+        def overrun_count():
+            if overrun and overruns != top:
+                overruns.next = overruns + 1
+
+        insts += [stream_handshake, overrun_count]
+    else:
+        sctl = ctl
+        insts.append(rectifier(clk, rst, r_start, fetch, rect, r_busy, quantizers=cal, frac=frac, depth=rect_depth))
     l_done, l_ovf = Signal(bool(0)), Signal(bool(0))
-    insts.append(frontend_sequencer(clk, rst, regs.mode, regs.continuous, regs.start, regs.stop, ctl, r_start,
+    insts.append(frontend_sequencer(clk, rst, regs.mode, regs.continuous, regs.start, regs.stop, sctl, r_start,
                                     r_busy, l_done, l_ovf, regs.busy, regs.frames, regs.frame_clocks,
                                     regs.list_overflows))
 
@@ -243,7 +289,6 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     insts.append(feature_list(clk, rst, list_in, feat, c_addr, c_data, tot_l, tot_r, l_ovf, l_done, width=width,
                               height=height, blocks=BLOCKS, border=border, max_features=max_features))
     c_reg = Signal(intbv(0)[16:])
-    top = (1 << 16) - 1
 
     @always_comb
     def count_port():
@@ -262,8 +307,8 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
 
     @always_comb
     def wiring():
-        regs.dropped_left.next = dropped_l
-        regs.dropped_right.next = dropped_r
+        regs.dropped_left.next = dropped_l + overruns
+        regs.dropped_right.next = dropped_r + overruns
         regs.harris_overflows.next = h_dropped_m + f_dropped
 
     insts += [count_port, count_regs, wiring]

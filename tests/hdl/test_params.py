@@ -252,7 +252,7 @@ def test_catalog_overrides_reach_the_block():
 # port or parameter, never in a MyHDL or Python internal error. New catalogue blocks are covered too.
 
 
-SMALL_FRAME = dict(width=16, height=8)
+SMALL_FRAME = dict(width=16, height=8, lines=4)  # lines: the line cache's (at most the height)
 
 
 #: Blocks with the standard ports (clk, rst, sink, source, control); the others (several clocks, other
@@ -541,7 +541,8 @@ def test_catalog_defaults_are_the_blocks_own():
     import inspect
 
     stated = {("convolve", "col"), ("convolve", "row"), ("convolve", "shift"), ("harris_stereo", "share"),
-              ("poly_unit", "quantizers"), ("coordinate_warper", "quantizers"), ("rectifier", "quantizers")}
+              ("poly_unit", "quantizers"), ("coordinate_warper", "quantizers"), ("rectifier", "quantizers"),
+              ("stream_rectifier", "quantizers")}
     for name, spec in BLOCKS.items():
         sig = inspect.signature(spec.func).parameters
         own = {k: v.default for k, v in sig.items() if v.kind is v.KEYWORD_ONLY}

@@ -55,6 +55,24 @@ def test_stereo_frontend(request, mode, single_clock):
     assert moved["moved_rect"] >= n * W * H and moved["moved_fetch"] > 0 and moved["moved_feat"] > 0
 
 
+@pytest.mark.sim
+@pytest.mark.parametrize("mode", ["sequential", "overlapped"])
+def test_stereo_frontend_stream(request, mode):
+    """rectify="stream" (issue 26): the cameras' words into the line cache, the frames rectified as they arrive;
+    the same register map, host driver and numpy chain; no camera word and no fetch in the SRAM."""
+    rep = run_bench("stereo_frontend", "tb_stereo_frontend",
+                    dict(mode=mode, frames=3, images="shift:3", timing=TIMING, require_features=True, pause=0.0,
+                         adaptive=None),
+                    name=request.node.name, params=dict(quantizers=SPEC, feature_words=256, max_features=127,
+                                                        rectify="stream"))
+    assert rep["bit_exact"] and len(rep["frames"]) == 3
+    pairs = [tuple(f["rect_pair"]) for f in rep["frames"]]
+    assert pairs == sorted(pairs) and len(set(pairs)) == 3
+    arb = rep["arb"]
+    assert arb["moved_cam0"] == arb["moved_cam1"] == arb["moved_fetch"] == 0  # 0 memory reads to rectify
+    assert arb["moved_rect"] >= 3 * W * H and arb["moved_feat"] > 0
+
+
 def test_model_is_the_chain():
     """The system model is the composition of the block models (spot check on one frame)."""
     from eyestereo.hdl.rectify.calibration import calibration_param

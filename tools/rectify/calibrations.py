@@ -18,10 +18,12 @@ into such a document (checked by :func:`~eyestereo.tools.rectify.ffc.read_quanti
     the perturbation, default 1; 3 and more give maps that leave the camera image over a large part of
     the frame). Exact maps (:func:`~eyestereo.tools.rectify.maps.ground_truth_maps`) of a ``WxH`` rectified
     image (default 352x288) into the 352x288 camera images, degree-3 fit, FFC.
-``"opencv"``
+``"opencv[@WxH]"``
     The shared OpenCV chessboard pairs (``$EYESTEREO_SHARED_DATA/opencv_stereo_calib``, default
     ``../shared/data`` beside the repository): calibration, thesis maps at 640x480, fit, FFC -- the whole
-    toolbox as ``eyestereo calibrate`` + ``eyestereo rectifier`` run it.
+    toolbox as ``eyestereo calibrate`` + ``eyestereo rectifier`` run it. With ``@WxH`` the calibration is
+    scaled to cameras of W x H pixels (the camera matrices' rows 0 and 1 times W/640 and H/480: the same
+    sensors read out at a lower resolution; distortion and pose unchanged) and the maps are W x H.
 a path
     Any ``quantizers.json`` (e.g. written by ``eyestereo rectifier``).
 
@@ -58,7 +60,7 @@ from eyestereo.tools.rectify.ffc import (
     run_ffc,
 )
 
-__all__ = ["DEFAULT_SPEC", "MAX_SIDE", "cache_dir", "load", "seeded_rig", "shared_data_dir"]
+__all__ = ["DEFAULT_SPEC", "MAX_SIDE", "cache_dir", "load", "scaled", "seeded_rig", "shared_data_dir"]
 
 DEFAULT_SPEC = "rig"
 #: Bump when a generator below changes what it builds (invalidates the cache).
@@ -151,10 +153,11 @@ def _parse(spec: str) -> tuple[str, dict[str, Any]]:
             raise ValueError(f"bad spread in calibration spec {spec!r}: want a number >= 0")
         w, h = _size(size or None, (352, 288))
         return "seed", dict(seed=int(parts[0]), spread=spread, width=w, height=h)
-    if spec == "opencv":
-        return "opencv", {}
+    if spec == "opencv" or spec.startswith("opencv@"):
+        size = _size(spec[7:], (0, 0)) if spec.startswith("opencv@") else None
+        return "opencv", dict(size=size)
     raise ValueError(f"unknown calibration spec {spec!r}: 'rig', 'rig:WxH', 'seed:N[:SPREAD][@WxH]', "
-                     f"'opencv' or the path of a quantizers.json")
+                     f"'opencv[@WxH]' or the path of a quantizers.json")
 
 
 def _polynomials(kind: str, args: dict[str, Any]) -> tuple[dict[str, list[float]], int, int, int, int]:
@@ -183,10 +186,31 @@ def _polynomials(kind: str, args: dict[str, Any]) -> tuple[dict[str, list[float]
                                 f"(set EYESTEREO_SHARED_DATA to the shared data folder)")
     cal = calibrate_stereo(str(data / "left*.jpg"), str(data / "right*.jpg"), board=(9, 6), square=0.025,
                            progress=False)
+    if args.get("size"):
+        cal = scaled(cal, *args["size"])
     maps = compute_maps(cal, method="thesis")
     f = fit(maps, 3)
     return ({n: [float(c) for c in f.coeffs[n]] for n in POLY_NAMES}, maps.width, maps.height,
             cal.image_width, cal.image_height)
+
+
+def scaled(cal, width: int, height: int):
+    """A :class:`~eyestereo.tools.rectify.calib.StereoCalibration` for the same cameras read out at ``width`` x
+    ``height`` pixels: each camera matrix's x row times ``width / image_width``, its y row times
+    ``height / image_height`` (pixel centres kept: ``c' = (c + 0.5) * s - 0.5``); distortion, R, T unchanged."""
+    from eyestereo.tools.rectify.calib import StereoCalibration
+
+    sx, sy = width / cal.image_width, height / cal.image_height
+    ms = []
+    for m in (cal.M1, cal.M2):
+        m = m.copy()
+        m[0, 0] *= sx
+        m[0, 1] *= sx
+        m[0, 2] = (m[0, 2] + 0.5) * sx - 0.5
+        m[1, 1] *= sy
+        m[1, 2] = (m[1, 2] + 0.5) * sy - 0.5
+        ms.append(m)
+    return StereoCalibration(ms[0], cal.D1, ms[1], cal.D2, cal.R, cal.T, width, height, cal.rms)
 
 
 def _cache_name(spec: str) -> str:
@@ -198,7 +222,7 @@ def _build(spec: str, kind: str, args: dict[str, Any]) -> dict[str, Any]:
     # The OpenCV calibration is the slow part (seconds); its polynomials are cached on their own.
     key_src: Any
     if kind == "opencv":
-        poly_file = folder / f"opencv.v{GENERATOR_VERSION}.poly.json"
+        poly_file = folder / f"{_cache_name(spec)}.v{GENERATOR_VERSION}.poly.json"
         if poly_file.exists():
             pdoc = json.loads(poly_file.read_text(encoding="utf-8"))
             polys, w, h, sw, sh = (pdoc["polynomials"], pdoc["width"], pdoc["height"], pdoc["source_width"],
