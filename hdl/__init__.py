@@ -44,6 +44,8 @@ _EXPORTS = {
     "sram_arbiter": "memory.sram_arbiter",
     "sram_subsystem": "memory.sram_subsystem",
     "sdram_controller": "memory.sdram_controller",
+    "sdram_bridge": "memory.sdram_bridge",
+    "sdram_subsystem": "memory.sdram_subsystem",
     "double_buffer": "memory.frame_buffers",
     "axis_to_stream": "axi.axis_to_stream",
     "stream_to_axis": "axi.stream_to_axis",

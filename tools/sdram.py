@@ -368,6 +368,9 @@ class SdramChip:
         period_ns: the clock period: the ns rules are checked against it.
         cas_latency: the CAS latency the mode register must set (None: any of 2, 3).
         strict: raise :class:`SdramViolation` at the first broken rule; else collect them in ``violations``.
+        record: keep every access, as :class:`~eyestereo.tools.sram.SramChip` does with ``log``: ``write_log``
+            (edge of the WRITE, word address, the word after the write), ``read_log`` (edge of the READ, word
+            address); a bench checks its reads and writes against them.
     """
 
     part: object = ULX3S
@@ -375,6 +378,7 @@ class SdramChip:
     cas_latency: int | None = None
     strict: bool = False
     log: int = 0  # keep the last ``log`` commands in ``command_log`` as (edge, command, bank, a)
+    record: bool = False  # keep every access in write_log / read_log
     violations: list = field(default_factory=list)
     stats: SdramStats = field(default_factory=SdramStats)
 
@@ -405,6 +409,8 @@ class SdramChip:
         self._full = (1 << p.data_bits) - 1
         self._nbytes = p.data_bits // 8
         self.command_log: list = []
+        self.write_log: list[tuple[int, int, int]] = []
+        self.read_log: list[tuple[int, int]] = []
 
     # ----------------------------------------------------------------------------------------------------
     def word(self, addr: int) -> int:
@@ -429,6 +435,10 @@ class SdramChip:
     def idle(self) -> bool:
         """No read data still to be driven."""
         return not self._reads
+
+    def pending(self) -> str:
+        """What is in flight, for a message."""
+        return f"{len(self._reads)} reads in flight (last edge {self._t}; data cycles {sorted(self._reads)[:4]})"
 
     def wants_dqm(self, t: int) -> bool:
         """Whether edge ``t``'s ``dqm`` masks read data (a read's word is driven in cycle ``t + 1``)."""
@@ -593,6 +603,8 @@ class SdramChip:
                     self._fail(t, "power-up", "READ before the mode register set the CAS latency")
                     return
                 self._reads[t + self.cl - 1] = [addr, 0]  # its dqm: at edge t + CL - 2 (below, in edge())
+                if self.record:
+                    self.read_log.append((t, addr))
             else:
                 self._write(t, ba, addr, p)
         elif cmd == "PRE":
@@ -662,5 +674,7 @@ class SdramChip:
                 m = 0xFF << (8 * b)
                 old = (old & ~m) | (p.dq_o & m)
         self.mem[addr] = old
+        if self.record:
+            self.write_log.append((t, addr, old))
         self.banks[ba].write = t
         self.stats.write_words += 1

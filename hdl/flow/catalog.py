@@ -45,7 +45,10 @@ from eyestereo.hdl.rectify.poly_unit import CoefPort, poly_unit
 from eyestereo.hdl.rectify.rectifier import rectifier
 from eyestereo.hdl.rectify.line_cache import line_cache
 from eyestereo.hdl.memory.sdram_controller import sdram_controller
+from eyestereo.hdl.memory.sdram_bridge import sdram_bridge
+from eyestereo.hdl.memory.sdram_subsystem import sdram_subsystem
 from eyestereo.hdl.interfaces.sdram_bus import SdramPins, SdramPort
+from eyestereo.tools.sdram import ULX3S
 from eyestereo.tools.sdram import part as sdram_part
 from eyestereo.hdl.rectify.stream_rectifier import stream_rectifier
 from eyestereo.hdl.rectify.calibration import calibration_of
@@ -436,6 +439,14 @@ for _b in (
     block("sdram_controller", "SDR SDRAM (the ULX3S's AS4C32M16SB): pins <-> in-order burst port, open rows, "
           "bank interleaving, auto refresh", sdram_controller, sink_width=_fixed(16), source_width=_fixed(16),
           build=_build_sdram_controller, clocks=_CLOCK_100),
+    block("sdram_bridge", "the SRAM arbiter's word port as one-word bursts on the SDRAM controller's port, tags kept",
+          sdram_bridge, sink_width=_fixed(16), source_width=_fixed(16),
+          build=lambda p: fresh_ports(sdram_bridge, cmd=SramCmd(tag_bits=TAG_BITS), rsp=SramRsp(tag_bits=TAG_BITS),
+                                      port=SdramPort(sdram_part(ULX3S).addr_bits, 1)), clocks=_CLOCK_100),
+    block("sdram_subsystem", "sram_arbiter + sdram_bridge + sdram_controller: the six masters on an SDR SDRAM",
+          sdram_subsystem, sink_width=_fixed(16), source_width=_fixed(8),
+          build=lambda p: fresh_ports(sdram_subsystem, **masters(p), sdram=SdramPins(sdram_part(p["part"]))),
+          clocks=_CLOCK_100),
     block("sram_subsystem", "sram_arbiter + sram_controller: the SRAM's pins and the six masters' ports",
           sram_subsystem, sink_width=_fixed(16), source_width=_fixed(8),
           build=lambda p: fresh_ports(sram_subsystem, **masters(p), sram=SramPins()), clocks=_CLOCK_100),
@@ -459,8 +470,9 @@ def _build_stream_cdc(p):
 def _build_stereo_frontend(p):
     from eyestereo.tools.regmap import REGMAP
 
+    mem = SdramPins(sdram_part(p["sdram_part"])) if p.get("memory") == "sdram" else SramPins()
     return fresh_ports(stereo_frontend, cam_l=CameraBus(), cam_r=CameraBus(), bus=AxiLite(REGMAP.addr_bits),
-                       sram=SramPins())
+                       sram=mem)
 
 
 for _b in (

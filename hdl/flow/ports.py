@@ -32,6 +32,8 @@ BUNDLES = (
     ("sram_bus", "SramRsp", "controller", "master", {}),
     ("sram_bus", "HostPort", "host", "arbiter", {}),
     ("sram_bus", "StatPort", "reader (register bank)", "arbiter", {}),
+    ("sdram_bus", "SdramPins", "FPGA (controller)", "SDRAM part", {}),
+    ("sdram_bus", "SdramPort", "master", "SDRAM controller", {}),
     ("camera_bus", "CameraBus", "camera", "FPGA", {}),
     ("axil", "AxiLite", "master", "slave (register bank)", {}),
     ("axis", "AxiStream", "master", "slave", dict(data_width=8)),

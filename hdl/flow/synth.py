@@ -75,7 +75,8 @@ CLOCK_GOALS = {
     **{b: 50.0 for b in ("line_delay", "convolve", "sobel", "harris_window", "cornerness", "prethreshold",
                          "nms", "harris_mono", "harris_stereo", "feature_list")},
     **{b: 100.0 for b in ("poly_unit", "coordinate_warper", "fetch_interpolate", "rectifier",
-                          "sram_controller", "sram_arbiter", "line_cache", "stream_rectifier", "sdram_controller")},
+                          "sram_controller", "sram_arbiter", "line_cache", "stream_rectifier", "sdram_controller",
+                          "sdram_bridge", "sdram_subsystem")},
 }
 #: The thesis's own fmax figures (MHz) where it gives one: ISE's estimate for the mono Harris, "no
 #: matter which kind of non-maximum suppression" (6.2.5).
@@ -101,6 +102,8 @@ VARIANTS = [
     ("stream_rectifier opencv@352x288", "stream_rectifier", dict(quantizers="opencv@352x288")),
     ("stream_rectifier opencv 640x480", "stream_rectifier", dict(quantizers="opencv")),
     ("stream_rectifier rig:640x480", "stream_rectifier", dict(quantizers="rig:640x480")),
+    ("stereo_frontend stream", "stereo_frontend", dict(rectify="stream")),
+    ("stereo_frontend sdram stream", "stereo_frontend", dict(memory="sdram", rectify="stream")),
 ]
 #: Clock ports a variant leaves unused (no goal row for them): the single-clock front end has no Harris clock.
 UNUSED_CLOCKS = {"stereo_frontend single-clock": ("hclk",)}

@@ -10,11 +10,15 @@ from eyestereo.hdl.interfaces.queue import check_queue
 from eyestereo.tools.camera import WORD as CAMERA_WORD
 from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 
-__all__ = ["FIRST_BEAT", "line_cache"]
+__all__ = ["BANK", "FIRST_BEAT", "line_cache"]
+
+#: Bytes of one block RAM of the ring (an ECP5 DP16KD or a Spartan-3E RAMB16 as 2048 x 9).
+BANK = 2048
+BANK_BITS = BANK.bit_length() - 1
 
 #: Clocks from a request moving (``req_valid`` and ``req_ready`` at an edge) to its first beat on the
-#: response, its rows being in: the request register, the beat expander, the block RAM, its output register (the
-#: block RAM's clock-to-output took most of the clock: issue 26), the response register.
+#: response, its rows being in: the request register, the beat expander, the block RAMs, each one's output register
+#: (a block RAM's clock-to-output takes most of a clock: issue 26), the response register (the bank's select).
 FIRST_BEAT = 6
 
 
@@ -74,8 +78,9 @@ def line_cache(clk, rst, cam0, cam1, fetch, start, run, arm, begun, overrun, *, 
     Latency: a fetch of rows already in: :data:`FIRST_BEAT` = 6 clocks to its first pixel, then one pixel per
     clock. A fetch waiting for its rows: 6 clocks after the camera word that completes the lower row.
 
-    Resources: 2 x ``lines`` x ``width`` bytes of block RAM (one write and one read port per camera), a ROM
-    of the ``lines`` slot addresses, two row counters, a request register and the beat expander.
+    Resources: per camera ``ceil(lines * width / 2048)`` block RAMs of 2048 bytes (one write and one read port
+    each; 6 at 352 x 32 lines, 20 at 640 x 64), their output registers and the bank select, a ROM of the ``lines``
+    slot addresses, two row counters, a request register and the beat expander (docs/memory.md).
     """
     check_clock(clk)
     check_reset(rst)
@@ -106,17 +111,47 @@ def line_cache(clk, rst, cam0, cam1, fetch, start, run, arm, begun, overrun, *, 
     slot_base = tuple(s * width for s in range(lines))  # the ROM: the first address of each slot
 
     insts = []
-    mems = [[Signal(intbv(0)[8:]) for _ in range(depth)] for _ in range(2)]
+    nbanks = -(-depth // BANK)  # the ring in block RAMs of BANK bytes each, the address's low bits within one
     rows = [Signal(intbv(0, min=0, max=height + 1)) for _ in range(2)]  # complete rows of the frame written
     lapped = [Signal(bool(0)) for _ in range(2)]
     fresh = [Signal(bool(0)) for _ in range(2)]
     lap_event = [Signal(bool(0)) for _ in range(2)]
     raddr = Signal(intbv(0, min=0, max=depth))
-    dout = [Signal(intbv(0)[8:]) for _ in range(2)]
-    dq0, dq1 = Signal(intbv(0)[8:]), Signal(intbv(0)[8:])  # the block RAMs' output registers
+    # each bank's word, registered straight after its block RAM: the bank select comes a clock later (issue 26:
+    # a ring of several block RAMs read through their select into one register missed 110 MHz)
+    q0 = [Signal(intbv(0)[8:]) for _ in range(nbanks)]
+    q1 = [Signal(intbv(0)[8:]) for _ in range(nbanks)]
+    r_lo = Signal(intbv(0)[BANK_BITS:])
+    r_hi, d_hi, o_hi = (Signal(intbv(0, min=0, max=nbanks)) for _ in range(3))
 
     @block
-    def writer(cam, mem, dout_c, row, lap, frsh, lap_ev):
+    def bank(we, waddr, wdata, q, *, index):
+        """One block RAM of the ring: BANK bytes, written where ``waddr`` falls in it, read at ``r_lo``."""
+        mem = [Signal(intbv(0)[8:]) for _ in range(BANK)]
+        sel = Signal(bool(0))
+        w_lo = Signal(intbv(0)[BANK_BITS:])
+        d = Signal(intbv(0)[8:])
+
+        @always_comb
+        def select():
+            sel.next = we and waddr // BANK == index
+            w_lo.next = waddr % BANK
+
+        @always(clk.posedge)
+        def ram():
+            # no reset: a memory with a reset is not a block RAM
+            if sel:
+                mem[w_lo].next = wdata
+            d.next = mem[r_lo]
+
+        @always(clk.posedge)
+        def out():
+            q.next = d
+
+        return select, ram, out
+
+    @block
+    def writer(cam, qs, row, lap, frsh, lap_ev):
         waddr = Signal(intbv(0, min=0, max=depth))
         at_start = Signal(bool(1))
         we = Signal(bool(0))
@@ -128,12 +163,13 @@ def line_cache(clk, rst, cam0, cam1, fetch, start, run, arm, begun, overrun, *, 
             token.next = cam.valid and cam.eof and not cam.eol
             we.next = cam.valid and not (cam.eof and not cam.eol)
 
-        @always(clk.posedge)
-        def ram():
-            # no reset: a memory with a reset is not a block RAM; both cameras' RAMs read the same address
-            if we:
-                mem[waddr].next = cam.data[8:0]
-            dout_c.next = mem[raddr]
+        wdata = Signal(intbv(0)[8:])
+
+        @always_comb
+        def luma():
+            wdata.next = cam.data[8:0]
+
+        banks = [bank(we, waddr, wdata, qs[b], index=b) for b in range(nbanks)]
 
         @always_seq(clk.posedge, reset=rst)
         def count():
@@ -172,10 +208,10 @@ def line_cache(clk, rst, cam0, cam1, fetch, start, run, arm, begun, overrun, *, 
             elif not run:
                 lap.next = False
 
-        return decode, ram, count
+        return decode, luma, banks, count
 
     for c, port in enumerate((cam0, cam1)):
-        insts.append(writer(port, mems[c], dout[c], rows[c], lapped[c], fresh[c], lap_event[c]))
+        insts.append(writer(port, (q0, q1)[c], rows[c], lapped[c], fresh[c], lap_event[c]))
 
     # ---- requests: one register, then the beat expander -------------------------------------------------
     q_valid = Signal(bool(0))
@@ -303,14 +339,19 @@ def line_cache(clk, rst, cam0, cam1, fetch, start, run, arm, begun, overrun, *, 
         d_cam.next = r_cam
         o_idx.next = d_idx
         o_cam.next = d_cam
-        dq0.next = dout[0]
-        dq1.next = dout[1]
+        d_hi.next = r_hi
+        o_hi.next = d_hi
         fetch.rsp_idx.next = o_idx
         if o_cam:
-            fetch.rsp_data.next = dq1
+            fetch.rsp_data.next = q1[o_hi]
         else:
-            fetch.rsp_data.next = dq0
+            fetch.rsp_data.next = q0[o_hi]
+
+    @always_comb
+    def read_address():
+        r_lo.next = raddr % BANK
+        r_hi.next = raddr // BANK
 
     insts += [request_ready, expander_state, camera_state, gate, requests, expander, response_valid,
-              response]
+              response, read_address]
     return insts

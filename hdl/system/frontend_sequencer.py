@@ -11,7 +11,7 @@ __all__ = ["frontend_sequencer"]
 
 @block
 def frontend_sequencer(clk, rst, mode, continuous, start, stop, ctl, rect_start, rect_busy, list_done,
-                       list_overflow, busy, frames, frame_clocks, list_overflows):
+                       list_overflow, busy, frames, frame_clocks, list_overflows, ready=None):
     """Drives the camera side of the frame handshake and the rectifier's ``start`` for the two modes.
 
     * **sequential** (``mode`` 0, the thesis's estimate): each stereo frame is one stage after the
@@ -39,6 +39,8 @@ def frontend_sequencer(clk, rst, mode, continuous, start, stop, ctl, rect_start,
         rect_start: output pulse to the rectifier; rect_busy: its ``busy``.
         list_done, list_overflow: feature_list's ``frame_done`` and ``overflow`` (memory clock).
         busy: output, 1 bit; frames, frame_clocks: outputs, 32 bits; list_overflows: output, 16 bits.
+        ready: optional input, 1 bit: the frame store is ready (an SDRAM after its power-up sequence); a
+            ``start`` before it is kept (``busy`` high) and taken once it is. None: always ready.
 
     Parameters: none.
 
@@ -59,6 +61,11 @@ def frontend_sequencer(clk, rst, mode, continuous, start, stop, ctl, rect_start,
     check_signal("frame_clocks", frame_clocks, width=32)
     check_signal("list_overflows", list_overflows, width=16)
 
+    if ready is None:
+        ready = Signal(bool(1))  # undriven: a constant 1 in the VHDL
+    else:
+        check_signal("ready", ready, width=1)
+    pend = Signal(bool(0))  # a start waiting for the frame store
     st_t = enum("IDLE", "ARM", "PAIR", "RSTART", "RFIRST", "RECT", "REL", "LISTS", "DRAIN")
     st = Signal(st_t.IDLE)
     md = Signal(bool(0))
@@ -84,7 +91,10 @@ def frontend_sequencer(clk, rst, mode, continuous, start, stop, ctl, rect_start,
         if st == st_t.IDLE:
             ctl.cam_run.next = 0
             ctl.cam_want.next = 0
-            if start:
+            if (start or pend) and not ready:
+                pend.next = 1
+            elif start or pend:
+                pend.next = 0
                 md.next = mode
                 more.next = continuous
                 t.next = 0
@@ -148,7 +158,7 @@ def frontend_sequencer(clk, rst, mode, continuous, start, stop, ctl, rect_start,
 
     @always_seq(clk.posedge, reset=rst)
     def outputs():
-        busy.next = st != st_t.IDLE
+        busy.next = st != st_t.IDLE or pend
         frames.next = nframes
         list_overflows.next = novf
 

@@ -25,6 +25,9 @@ from eyestereo.hdl.rectify.stream_rectifier import stream_rectifier
 from eyestereo.hdl.system.register_bank import RegisterPorts, register_bank
 from eyestereo.hdl.interfaces.sram_bus import HostPort, SramPins, StatPort, check_bundle
 from eyestereo.hdl.memory.sram_subsystem import sram_subsystem
+from eyestereo.hdl.memory.sdram_subsystem import sdram_subsystem
+from eyestereo.hdl.interfaces.sdram_bus import SdramPins
+from eyestereo.tools.sdram import ULX3S
 from eyestereo.hdl.interfaces.stream import ImageStream
 from eyestereo.hdl.streaming.queue_slice import queue_slice
 from eyestereo.hdl.streaming.stream_cdc import stream_cdc
@@ -36,10 +39,12 @@ from eyestereo.tools.constants import NMS_DEFAULT, NMS_SIZES, THRESHOLD_BLOCKS
 from eyestereo.tools.regmap import REGMAP
 from eyestereo.tools.sram import KINDS
 
-__all__ = ["stereo_frontend", "BLOCKS", "CAM_DEPTH", "RECTIFY", "THR_BITS"]
+__all__ = ["stereo_frontend", "BLOCKS", "CAM_DEPTH", "MEMORY", "RECTIFY", "THR_BITS"]
 
 #: The rectification choices: from the frame store (the thesis's) or from an on-chip line cache.
 RECTIFY = ("fetch", "stream")
+#: The frame stores: the EyeBot's synchronous SRAM, or a 16-bit SDR SDRAM.
+MEMORY = ("sram", "sdram")
 
 #: Threshold blocks per camera (:data:`eyestereo.tools.constants.THRESHOLD_BLOCKS`): the register map's 16
 #: thresholds and 32 per-block counts.
@@ -58,7 +63,8 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
                     frac: int | None = unit_model.DEFAULT_FRAC, nms: int = NMS_DEFAULT, border: int | None = None,
                     max_features: int = 1023, feature_words: int = 2048, cam_depth: int = CAM_DEPTH,
                     kind: str = "nobl", read_latency: int = 2, order: str = "YUYV", rect_depth: int = DEFAULT_DEPTH,
-                    single_clock: bool = False, rectify: str = "fetch", cache_lines: int | None = None):
+                    single_clock: bool = False, rectify: str = "fetch", cache_lines: int | None = None,
+                    memory: str = "sram", sdram_part: str = ULX3S):
     """The complete stereo front end of the thesis's Fig. 7.2, with the processor's register bus.
 
     Data flow: each camera bus -> :func:`~eyestereo.hdl.camera.camera_interface.camera_pair` (converter and
@@ -88,7 +94,9 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
         cam_l, wrst_l, cam_r, wrst_r: the camera buses (:class:`~eyestereo.hdl.interfaces.camera_bus.CameraBus`,
             each clocked by its own PCLK) and each camera domain's synchronous reset.
         bus: :class:`~eyestereo.hdl.interfaces.axil.AxiLite` slave (the register map's address bits), memory clock.
-        sram: :class:`~eyestereo.hdl.interfaces.sram_bus.SramPins`.
+        sram: the memory's pins: :class:`~eyestereo.hdl.interfaces.sram_bus.SramPins`, or
+            :class:`~eyestereo.hdl.interfaces.sdram_bus.SdramPins` with ``memory="sdram"`` (the ports keep the
+            prefix ``sram_``).
 
     Parameters:
         quantizers, frac: the calibration (a spec such as ``"rig:64x48"``, a quantizers.json or a
@@ -117,6 +125,13 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
             runs through and is counted in both DROPPED registers.
         cache_lines: the line cache's lines per camera (``rectify="stream"``); default: the calibration's plan
             (:func:`eyestereo.tools.models.line_cache.plan`).
+        memory: ``"sram"`` (default, the EyeBot's 1M x 18 synchronous SRAM: ``sram`` is
+            :class:`~eyestereo.hdl.interfaces.sram_bus.SramPins`, ``kind`` and ``read_latency`` describe it) or
+            ``"sdram"`` (a 16-bit SDR SDRAM such as the ULX3S's: ``sram`` is
+            :class:`~eyestereo.hdl.interfaces.sdram_bus.SdramPins` of ``sdram_part``, run at 100 MHz, CAS latency 2,
+            by :func:`~eyestereo.hdl.memory.sdram_subsystem.sdram_subsystem`): the same masters, address map,
+            register map and host driver. Pair it with ``rectify="stream"`` (the 2x2 fetches jump rows).
+        sdram_part: the SDRAM part (:mod:`eyestereo.tools.sdram`'s name or spec), for ``memory="sdram"``.
 
     Latency: a frame's features are complete a few lines (Harris's lead, :func:`harris_stereo.latency`)
     after the rectifier's last beat; the sequencer's ``frame_clocks`` measures the whole.
@@ -132,7 +147,8 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     check_reset(wrst_l, "wrst_l")
     check_reset(wrst_r, "wrst_r")
     check_axil("bus", bus, addr_bits=REGMAP.addr_bits)
-    check_bundle("sram", sram, SramPins)
+    memory = check_choice("memory", memory, MEMORY)
+    check_bundle("sram", sram, SramPins if memory == "sram" else SdramPins)
     cal = calibration_param(quantizers, None, None)
     if (cal.width, cal.height) != (cal.source_width, cal.source_height):
         raise block_error(f"parameter quantizers: the calibration rectifies {cal.source_width}x{cal.source_height} "
@@ -182,8 +198,14 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     host, stat, ctl = HostPort(), StatPort(), FrameControl()
     fcount = StatPort(5, 16)
     regs = RegisterPorts()
-    insts.append(sram_subsystem(clk, rst, m_cam0, m_cam1, fetch, rect, feat, host, ctl, stat, sram, kind=kind,
-                                read_latency=read_latency, width=width, height=height, feature_words=feature_words))
+    mem_ready = Signal(bool(memory == "sram"))  # the SRAM: always (undriven: a constant); the SDRAM: after power-up
+    if memory == "sram":
+        insts.append(sram_subsystem(clk, rst, m_cam0, m_cam1, fetch, rect, feat, host, ctl, stat, sram, kind=kind,
+                                    read_latency=read_latency, width=width, height=height,
+                                    feature_words=feature_words))
+    else:
+        insts.append(sdram_subsystem(clk, rst, m_cam0, m_cam1, fetch, rect, feat, host, ctl, stat, sram, mem_ready,
+                                     part=sdram_part, width=width, height=height, feature_words=feature_words))
     insts.append(register_bank(clk, rst, bus, regs, stat, fcount, host, width=width, height=height))
 
     # ---- rectifier and sequencer -----------------------------------------------------------------
@@ -216,7 +238,7 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     l_done, l_ovf = Signal(bool(0)), Signal(bool(0))
     insts.append(frontend_sequencer(clk, rst, regs.mode, regs.continuous, regs.start, regs.stop, sctl, r_start,
                                     r_busy, l_done, l_ovf, regs.busy, regs.frames, regs.frame_clocks,
-                                    regs.list_overflows))
+                                    regs.list_overflows, mem_ready))
 
     # ---- into the Harris clock and back (or, single_clock, straight) ------------------------------------
     hclk_, hrst_ = (clk, rst) if single_clock else (hclk, hrst)

@@ -1,4 +1,5 @@
-"""cocotb bench: sram_subsystem (arbiter + controller) with traffic on all six ports against the SRAM model.
+"""cocotb bench: sram_subsystem (arbiter + controller) with traffic on all six ports against the SRAM model,
+or sdram_subsystem (arbiter + bridge + SDRAM controller) against the SDRAM model.
 
 Agents (:mod:`eyestereo.sim.lib.sram_agents`) drive both cameras at their rate through FIFO models, the
 rectified stereo stream, feature lists, the rectifier's fetch requests and the host's random accesses
@@ -16,11 +17,19 @@ access. Checks, online and after the run:
   the complete frames in the SRAM;
 * nothing is left over: every agent idle, the SRAM model idle.
 
+The memory is the config's ``memory`` (``"sram"`` or ``"sdram"``; default from the block's name). On the
+SDRAM the part is the block's ``part`` parameter (the model reads the same spec, so a shortened power-up
+wait is checked as such); the model starts before the reset ends (it checks the power-up sequence), every
+access is logged as the SRAM's is, and the same checks run on those logs; besides them, no rule of the
+part broken (:class:`~eyestereo.tools.sdram.SdramChip`, every edge) and no refresh late. The SRAM-only
+bus figures (drive and idle cycles) are left out there.
+
 The report (``report.json``) carries the measurements the benchmark script turns into docs/sram.md.
 """
 
 from __future__ import annotations
 
+import copy
 import random
 
 import cocotb
@@ -28,10 +37,12 @@ from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, RisingEdge
 
 from eyestereo.sim.lib.bench import load_config, write_report
+from eyestereo.sim.lib.sdram_model import SdramModel
 from eyestereo.sim.lib.sram_agents import CameraSource, FeatureSource, FetchMaster, HostMaster, Pin, StereoSource
 from eyestereo.sim.lib.sram_model import SramModel, read_int
 from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 from eyestereo.tools.models.sram_arbiter import MASTERS, STAT, WRITERS, AddressMap, BufferHistory, fetch_addresses
+from eyestereo.tools.sdram import ULX3S
 from eyestereo.tools.sram import SramPart
 
 PERIOD_NS = 10
@@ -186,7 +197,10 @@ async def read_stat(dut, clk) -> dict[int, int]:
 async def subsystem_traffic(dut):
     cfg = load_config()
     p = cfg["params"]
-    part = SramPart(p.get("kind", "nobl"), p.get("read_latency", 2))
+    memory = cfg.get("memory", "sdram" if cfg.get("block") == "sdram_subsystem" else "sram")
+    if memory not in ("sram", "sdram"):
+        raise ValueError(f"config memory must be 'sram' or 'sdram', got {memory!r}")
+    sdram = memory == "sdram"
     w, h = p.get("width", FRAME_WIDTH), p.get("height", FRAME_HEIGHT)
     amap = AddressMap(w, h, p.get("feature_words", 8192))
     seed = cfg.get("seed", 1)
@@ -197,11 +211,31 @@ async def subsystem_traffic(dut):
                  "ctl_rect_release", "ctl_feat_want", "ctl_feat_release", "stat_addr"):
         getattr(dut, name).value = 0
     dut.rst.value = 1
-    await ClockCycles(clk, 3)
-    dut.rst.value = 0
-    await RisingEdge(clk)
-    model = SramModel(dut, clk, part, log=True)
-    model.start()
+    if sdram:
+        # the model watches from the controller's first edge in reset: the whole power-up sequence
+        # model_part: a board whose part differs from the one the block was built for (the negative tests)
+        model = SdramModel(dut, clk, cfg.get("model_part", p.get("part", ULX3S)), prefix="sdram", period_ns=PERIOD_NS,
+                           cas_latency=p.get("cas_latency", 2), record=True)
+        await ClockCycles(clk, 2)
+        model.start()
+        await ClockCycles(clk, 1)
+        dut.rst.value = 0
+        # as the front end, start no traffic before the power-up sequence (the rectified stream has no
+        # back-pressure: its words would be lost while the part cannot be written)
+        ck = model.part.clocks(1000.0 / PERIOD_NS)
+        for _ in range(ck.powerup + (model.part.init_refreshes + 2) * (ck.rfc + ck.rp) + 100):
+            await RisingEdge(clk)
+            if model.chip.ready:
+                break
+        assert model.chip.ready, f"the SDRAM's power-up sequence not complete {ck.powerup} clocks after reset"
+        edge_now = model.edge_now
+    else:
+        await ClockCycles(clk, 3)
+        dut.rst.value = 0
+        await RisingEdge(clk)
+        model = SramModel(dut, clk, SramPart(p.get("kind", "nobl"), p.get("read_latency", 2)), log=True)
+        model.start()
+        edge_now = model._edge_number
 
     cams = [CameraSource(dut, f"cam{c}", random.Random(seed * 10 + c), width=w, height=h,
                          rate=cfg.get("cam_rate", 0.09), depth=cfg.get("cam_fifo", 64),
@@ -256,7 +290,7 @@ async def subsystem_traffic(dut):
                   "held", fetch.held, ctl.held)
         clock += 1
         if clock in (window, clocks) and not draining:
-            snap[clock] = dict(edge=model._edge_number(), stats=dict(vars(model.chip.stats)),
+            snap[clock] = dict(edge=edge_now(), stats=copy.deepcopy(vars(model.chip.stats)),
                                cam_fill=[c.max_fill for c in cams], held=fetch_held_clocks)
         if clock == clocks and not draining:
             draining = True
@@ -282,12 +316,16 @@ async def subsystem_traffic(dut):
         getattr(dut, name).value = 0
     # let the writers flush their last words and the pipeline empty
     await ClockCycles(clk, 64)
-    assert model.chip.idle, (f"the SRAM model still has {model.chip.pending()}; last writes "
+    assert model.chip.idle, (f"the {memory.upper()} model still has {model.chip.pending()}; last writes "
                              f"{[(e, hex(a), hex(d)) for e, a, d in model.chip.write_log[-6:]]}, clock {clock}; "
                              f"{sum(1 for e, a, d in model.chip.write_log if a in (4 * amap.frame, 5 * amap.frame))} "
                              f"base writes of {len(model.chip.write_log)}; {stereo.sent[-1][:3]}, {len(stereo.sent)}")
     stat = await read_stat(dut, clk)
     assert all(v is not None for v in stat.values()), f"undefined status words: {stat}"
+    if sdram:
+        model.finish()
+        assert not model.violations, f"{len(model.violations)} SDRAM rules broken: {model.violations[:4]}"
+        assert model.stats.late_refreshes == 0, f"{model.stats.late_refreshes} refreshes late"
 
     # ---- offline checks against the SRAM's logs ------------------------------------------------------
     wl, rl = model.chip.write_log, model.chip.read_log
@@ -347,7 +385,8 @@ async def subsystem_traffic(dut):
             continue
         published = stat[2 * len(MASTERS) + 1 + i] & 0xFFFF
         complete = len(hist[k].complete_runs())
-        assert published == complete, f"{k}: {published} frames published, {complete} complete in the SRAM"
+        assert published == complete, \
+            f"{k}: {published} frames published, {complete} complete in the {memory.upper()}"
     assert stat[19] >> 16 == 0, f"the rectified writer lost {stat[19] >> 16} words"
     for k in ("cam0", "cam1")[:0 if lossy else 2]:
         runs = hist[k].runs
@@ -370,14 +409,15 @@ async def subsystem_traffic(dut):
                 per["fetch" if region_of(a) in ("cam0", "cam1") else "host"] += 1
         s0, s1 = snap[window]["stats"], snap[clocks]["stats"]
         n_clk = e1 - e0
+        bus_keys = (("read_words", "write_words", "refreshes") if sdram else
+                    ("reads", "writes", "sram_drive_cycles", "fpga_drive_cycles", "idle_bus_cycles"))
         measured = dict(clocks=n_clk, words=per, words_per_clock={m: per[m] / n_clk for m in MASTERS},
                         total_per_clock=sum(per.values()) / n_clk,
-                        bus={k: (s1[k] - s0[k]) / n_clk for k in ("reads", "writes", "sram_drive_cycles",
-                                                                    "fpga_drive_cycles", "idle_bus_cycles")},
+                        bus={k: (s1[k] - s0[k]) / n_clk for k in bus_keys},
                         fetch_held=snap[clocks]["held"] - snap[window]["held"],
                         cam_max_fill=[c.max_fill for c in cams])
     report = dict(
-        clocks=total, edges=st.edges, sram=vars(st), stat={STAT[k]: v for k, v in stat.items()},
+        clocks=total, edges=st.edges, **{memory: vars(st)}, stat={STAT[k]: v for k, v in stat.items()},
         moved=moved, waited={m: stat[len(MASTERS) + i] for i, m in enumerate(MASTERS)},
         frames={k: len(hist[k].complete_runs()) for k in hist},
         frames_sent={k: len(sent[k]) for k in WRITERS},

@@ -43,6 +43,7 @@ from cocotb.triggers import ClockCycles, Edge, Timer
 from eyestereo.sim.lib.axil import AxiLiteHost
 from eyestereo.sim.lib.bench import load_config, write_report
 from eyestereo.sim.lib.camera import CameraModel, camera_frame
+from eyestereo.sim.lib.sdram_model import SdramModel
 from eyestereo.sim.lib.sram_model import SramModel
 from eyestereo.tools.camera import CameraTiming, frame_schedule
 from eyestereo.tools.constants import K_CODE_DEFAULT
@@ -51,6 +52,7 @@ from eyestereo.tools.models import stereo_frontend as model
 from eyestereo.tools.models.feature_list import parse_words
 from eyestereo.tools.models.sram_arbiter import AddressMap
 from eyestereo.tools.regmap import ARB_WORDS
+from eyestereo.tools.sdram import ULX3S
 from eyestereo.tools.sram import SramPart
 
 
@@ -187,7 +189,12 @@ async def frames_bit_exact(dut):
     await ClockCycles(dut.clk, 6)
     for r in ("rst", "hrst", "wrst_l", "wrst_r"):
         getattr(dut, r).value = 0
-    sram = SramModel(dut, dut.clk, SramPart(cfg["params"].get("kind", "nobl"), cfg["params"].get("read_latency", 2)))
+    if cfg["params"].get("memory", "sram") == "sdram":  # the SDR SDRAM's rules on its pins (issue 26)
+        sram = SdramModel(dut, dut.clk, cfg["params"].get("sdram_part", ULX3S), prefix="sram", period_ns=10.0,
+                          cas_latency=2)
+    else:
+        part = SramPart(cfg["params"].get("kind", "nobl"), cfg["params"].get("read_latency", 2))
+        sram = SramModel(dut, dut.clk, part)
     sram.start()
     drv = HostDriver(bus)
     await drv.check_id()
@@ -344,7 +351,14 @@ async def frames_bit_exact(dut):
     ovf = check_list_overflows(st, results, [model_of(i, j)["list"]["overflow"] for i in range(n_cam)
                                              for j in range(max(0, i - 1), min(n_cam, i + 2))]
                                if st["frames"] > len(results) and adaptive is None else None)
-    assert sram.error is None, sram.error
+    sdram = None
+    if isinstance(sram, SdramModel):
+        sram.finish()
+        assert not sram.violations, f"{len(sram.violations)} SDRAM rules broken, first: {sram.violations[:3]}"
+        assert sram.stats.late_refreshes == 0, f"{sram.stats.late_refreshes} refreshes late"
+        sdram = dict(refreshes=sram.stats.refreshes, late_refreshes=sram.stats.late_refreshes)
+    else:
+        assert sram.error is None, sram.error
     bus.checker.check()
     if cfg.get("require_features"):
         # the configuration asks for features (a frame without any tests little); the closed loop may drive
@@ -352,7 +366,7 @@ async def frames_bit_exact(dut):
         assert all(r["features"] > 0 for r in results) if adaptive is None else \
             any(r["features"] for r in results), [r["features"] for r in results]
     write_report(cfg, dict(mode=mode, width=w, height=h, threshold=thr, frames=results, bit_exact=True,
-                           model_params=mp, list_overflows=ovf,
+                           model_params=mp, list_overflows=ovf, sdram=sdram,
                            frame_clocks=st["frame_clocks"], frames_done=st["frames"], arb=arb,
                            arb_words=list(ARB_WORDS), total_ns=get_sim_time(unit="ns") - t_start,
                            camera_frame_pclk=timing.frame_pclk, axi=bus.checker.counts, last=last,

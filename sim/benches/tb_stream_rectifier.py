@@ -116,9 +116,10 @@ async def stream_rectifier_frames(dut):
     for f in range(frames):
         s = specs[f % len(specs)]
         left = make_frame(s, w, h).astype(np.uint8)
-        right = make_frame(s.replace("random:", "random:1") if s.startswith("random:") else s, w, h).astype(np.uint8)
-        if not s.startswith("random:"):
-            right = np.roll(left, -3, axis=1)  # a disparity of 3 px, the right camera's view
+        if s.startswith("random:"):  # the right camera's noise of its own
+            right = make_frame(f"random:{int(s[7:]) + 1000}", w, h).astype(np.uint8)
+        else:  # a scene: the right camera sees it 3 px to the left (a disparity of 3)
+            right = np.roll(left, -3, axis=1)
         pairs.append((left, right))
     await reset(dut, dut.clk)
     await FallingEdge(dut.clk)
@@ -137,7 +138,7 @@ async def stream_rectifier_frames(dut):
         await ClockCycles(dut.clk, 1000)
     expect_overrun = bool(cfg.get("expect_overrun"))
     report = dict(width=cal.width, height=cal.height, frames=frames, beats=len(tb.beats), overruns=tb.overruns,
-                  line_ns=tb.line_ns, frame_ns=tb.frame_ns, sim="")
+                  line_ns=tb.line_ns, frame_ns=tb.frame_ns)
     if expect_overrun:
         assert tb.overruns > 0, "the cache was too small for the calibration, and overrun never pulsed"
         report["bit_exact"] = None

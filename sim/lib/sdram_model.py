@@ -5,7 +5,8 @@ there); this module connects :class:`~eyestereo.tools.sdram.SdramChip` to the DU
 (:class:`~eyestereo.hdl.interfaces.sdram_bus.SdramPins`): it samples the pins at each rising edge and
 drives ``<prefix>_dq_i`` with the part's read data for the following cycle (``Z`` where the part does not
 drive, e.g. bytes masked by DQM). Broken rules are collected in :attr:`SdramModel.violations` (each with
-its edge, time and rule); the bench fails on any.
+its edge, time and rule); the bench fails on any. ``record=True`` keeps every access in the chip's
+``write_log`` and ``read_log`` (:class:`~eyestereo.tools.sdram.SdramChip`), as the SRAM model's ``log``.
 
 The model's clock period (``period_ns``) is the one the ns rules are checked against: the bench gives the
 period of the clock it runs, so a controller that counted its clocks for a faster clock is caught.
@@ -29,11 +30,12 @@ class SdramModel:
     """The SDRAM part on ``<prefix>_*`` of ``dut``; :meth:`start` it before the controller leaves reset."""
 
     def __init__(self, dut, clk, part, *, prefix: str = "pins", period_ns: float = 10.0,
-                 cas_latency: int | None = None, sleep: bool = True, log: int = 0):
+                 cas_latency: int | None = None, sleep: bool = True, log: int = 0, record: bool = False):
         self.clk = clk
         self.part = sdram_part(part)
         self.period_ns = period_ns
-        self.chip = SdramChip(self.part, period_ns=period_ns, cas_latency=cas_latency, strict=False, log=log)
+        self.chip = SdramChip(self.part, period_ns=period_ns, cas_latency=cas_latency, strict=False, log=log,
+                              record=record)
         self.sleep = sleep
         g = lambda f: getattr(dut, f"{prefix}_{f}")  # noqa: E731
         self.h_cke, self.h_cs_n, self.h_ras_n, self.h_cas_n, self.h_we_n = (g(f) for f in (

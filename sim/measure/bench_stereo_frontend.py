@@ -75,11 +75,14 @@ def _kept(tag: str) -> Path:
 
 
 def run_mode(mode: str, size: str, frames: int, timing: dict, sim: str, reuse: bool = False,
-             backend: str | None = None, single_clock: bool = False, **extra) -> dict:
+             backend: str | None = None, single_clock: bool = False, options: dict | None = None, **extra) -> dict:
     """One bench run, its report kept in build/system/runs/ (with the wall time and the simulator);
-    ``single_clock``: the top built with harris_stereo in the memory clock (issue 23's option)."""
+    ``single_clock``: the top built with harris_stereo in the memory clock (issue 23's option); ``options``: more
+    parameters of the top (``memory``, ``rectify``: issue 26's front-end options)."""
+    options = dict(options or {})
+    opt_tag = "".join(f"_{v}" for _, v in sorted(options.items()))
     tag = (f"{sim}{'-' + backend if backend else ''}_{mode}_{size}" + ("_speed" if extra.get("speed_us") else "")
-           + ("_single" if single_clock else ""))
+           + ("_single" if single_clock else "") + opt_tag)
     kept = _kept(tag)
     if reuse and kept.is_file():
         rep = json.loads(kept.read_text())
@@ -94,9 +97,9 @@ def run_mode(mode: str, size: str, frames: int, timing: dict, sim: str, reuse: b
                     dict(dict(mode=mode, frames=frames, images="shift:3", timing=timing, target=200 if full else 40,
                               require_features=not extra.get("speed_us")), **extra),
                     name=f"bench_{mode}_{size}" + ("_speed" if extra.get("speed_us") else "") +
-                    ("_single" if single_clock else ""), sim=sim, backend=backend,
+                    ("_single" if single_clock else "") + opt_tag, sim=sim, backend=backend,
                     params=dict(quantizers=f"rig:{size}", feature_words=512, max_features=255,
-                                **(dict(single_clock=True) if single_clock else {})),
+                                **(dict(single_clock=True) if single_clock else {}), **options),
                     log_file=RUNS / f"{tag}.log", public=PUBLIC if sim == "verilator" else None)
     # the speed probe's own wall_s is the probe's time alone; the run's (build included) beside it
     rep["wall_total_s" if rep.get("speed") else "wall_s"] = round(time.time() - t0, 1)
@@ -694,6 +697,54 @@ def main_single(args) -> int:
     return 0
 
 
+OPTIONS_TITLE = "## The front end with its memory and rectification options (issue 26)"
+
+
+def main_options(args) -> int:
+    """``--memory`` / ``--rectify``: both modes of the top with those options at --size (352x288: the OV6630's
+    timing at 17.73-18 MHz; 640x480: the OV7670's VGA frame at 24 MHz), the section of ``docs/memory.md``."""
+    from eyestereo.tools.camera import VGA_TIMING
+
+    sim = args.sim or fastest_simulator()
+    options = dict(memory=args.memory, rectify=args.rectify)
+    w, h = (int(v) for v in args.size.split("x"))
+    vga = (w, h) == (VGA_TIMING.width, VGA_TIMING.height)
+    timing = (dict(h_blank=VGA_TIMING.h_blank, v_sync=VGA_TIMING.v_sync, v_back=VGA_TIMING.v_back,
+                   v_front=VGA_TIMING.v_front) if vga else timing_of(args.size))
+    # VGA cameras at 24 MHz (the OV7670's PCLK), slightly apart as two oscillators are; CIF at the bench's 18/17.9
+    cams = dict(cam_l_mhz=24.0, cam_r_mhz=23.9) if vga else {}
+    try:
+        reps = {m: run_mode(m, args.size, n, timing, sim, args.reuse, options=options, **cams)
+                for m, n in (("sequential", args.frames), ("overlapped", args.frames_ovl))}
+    except (AssertionError, RuntimeError) as e:
+        print(f"error: a bench run failed ({str(e).splitlines()[0][:200]})", file=sys.stderr)
+        return 1
+    cam = CameraTiming(width=w, height=h, **timing)
+    figs = {m: figures(r, cam) for m, r in reps.items()}
+    title = f"{OPTIONS_TITLE[:-1]}, {args.size}: memory={args.memory}, rectify={args.rectify})"
+    arb = reps["overlapped"].get("arb", {})
+    moved = {k[6:]: v for k, v in arb.items() if k.startswith("moved_")}
+    total = sum(moved.values()) or 1
+    section = [title, "",
+               f"`stereo_frontend(memory=\"{args.memory}\", rectify=\"{args.rectify}\")`, rig calibration at "
+               f"{args.size}, cameras {'24 / 23.9' if vga else '18 / 17.9'} MHz, {sim_label(sim)}; every frame read back "
+               "by the host over AXI4-Lite bit for bit against the numpy chain"
+               + (", the SDRAM model checking every rule of the part (none broken, no refresh late)"
+                  if args.memory == "sdram" else "") + ":", "", *_mode_rows(figs), "",
+               "Words moved per master in the overlapped run (share of the memory's traffic): " + ", ".join(
+                   f"{k} {v} ({100 * v / total:.1f} %)" for k, v in moved.items()) + "; "
+               f"clocks of the run: {arb.get('clocks', '?')}.", ""]
+    if args.memory == "sdram":
+        sd = {m: r.get("sdram") or {} for m, r in reps.items()}
+        section += ["SDRAM refreshes: " + ", ".join(f"{m} {v.get('refreshes', '?')} (late "
+                                                    f"{v.get('late_refreshes', '?')})" for m, v in sd.items()) + ".", ""]
+    splice_section(args.options_out, section, title=title)
+    print(json.dumps(dict(options=options, size=args.size, simulator=sim,
+                          fps={m: round(f["fps"], 2) for m, f in figs.items()},
+                          bit_exact={m: r["bit_exact"] for m, r in reps.items()})))
+    return 0
+
+
 def _size(text: str) -> str:
     return "{}x{}".format(*frame_size(text))
 
@@ -756,7 +807,14 @@ def main(argv=None) -> int:
                     help="only the single-clock build (stereo_frontend(single_clock=True)), both modes at --size "
                          "(--frames, --frames-ovl); its section of --out is replaced in place")
     ap.add_argument("--reuse", action="store_true", help="take the runs' reports from build/system/runs/ if there")
+    ap.add_argument("--memory", choices=("sram", "sdram"), help="only the top with this frame store, both modes at "
+                    "--size; its section of --options-out is replaced in place")
+    ap.add_argument("--rectify", choices=("fetch", "stream"), default="stream",
+                    help="with --memory: the rectification option (default stream)")
+    ap.add_argument("--options-out", type=Path, default=ROOT / "docs" / "memory.md")
     args = ap.parse_args(argv)
+    if args.memory is not None:
+        return main_options(args)
     if args.real is not None:
         return main_real(args)
     if args.single_clock:

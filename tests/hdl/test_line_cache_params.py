@@ -64,3 +64,22 @@ def test_frontend_rectify_choice():
         spec.elaborate(quantizers="rig:32x24", rectify="cache")
     with pytest.raises(ValueError, match="cache_lines is for rectify='stream'"):
         spec.elaborate(quantizers="rig:32x24", cache_lines=8)
+
+
+def test_frontend_memory_choice():
+    from eyestereo.hdl.flow.catalog import get
+    from eyestereo.hdl.interfaces.sdram_bus import SdramPins
+    from eyestereo.hdl.interfaces.sram_bus import SramPins
+
+    spec = get("stereo_frontend")
+    with pytest.raises(ValueError, match="memory"):
+        spec.elaborate(quantizers="rig:32x24", memory="ddr3")
+    # the pins must be the memory's: SramPins for an SDRAM is refused, and the reverse
+    ports, kw, _ = spec.ports(quantizers="rig:32x24", memory="sdram")
+    ports["sram"] = SramPins()
+    with pytest.raises(ValueError, match="sram"):
+        spec.func(*ports.values(), **kw)
+    ports, kw, _ = spec.ports(quantizers="rig:32x24")
+    ports["sram"] = SdramPins()
+    with pytest.raises(ValueError, match="sram"):
+        spec.func(*ports.values(), **kw)

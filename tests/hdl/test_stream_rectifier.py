@@ -46,3 +46,19 @@ def test_stream_rectifier_plan_is_what_the_bench_needs(request):
                     dict(SMALL, frames=1, images="random:5", skew=0, expect_overrun=True), name=request.node.name,
                     params=dict(quantizers=spec, lines=p.lines // 8))
     assert rep["overruns"] > 0
+
+
+@pytest.mark.parametrize("sim", ["icarus", pytest.param("verilator", marks=pytest.mark.othersims)])
+def test_stream_rectifier_verilog(request, sim):
+    """MyHDL's Verilog conversion of the block (line cache, rectifier) on the Verilog simulators: the same beats
+    (Verilator with ``make test-sims``)."""
+    import shutil
+
+    if sim == "icarus" and shutil.which("iverilog") is None:
+        pytest.skip("Icarus Verilog not installed")
+    spec = "rig:32x24"
+    p = small_plan(spec)
+    rep = run_bench("stream_rectifier", "tb_stream_rectifier",
+                    dict(SMALL, frames=2, images=["random:7", "file:chessboard_left01.jpg"], skew=0.5),
+                    name=request.node.name, params=dict(quantizers=spec, lines=p.lines), sim=sim)
+    assert rep["bit_exact"] and rep["overruns"] == 0 and rep["beats"] == 2 * 2 * 32 * 24

@@ -125,8 +125,8 @@ def init_seq(cl=2):
     return s
 
 
-def run(seq, *, last=None, period=10.0, cl=2, spec=FAST):
-    chip = SdramChip(spec, period_ns=period, cas_latency=cl)
+def run(seq, *, last=None, period=10.0, cl=2, spec=FAST, record=False):
+    chip = SdramChip(spec, period_ns=period, cas_latency=cl, record=record)
     out = {}
     for t in range(1, (last or max(seq)) + 1):
         out[t] = chip.edge(t, Pins(**{**NOP, **seq.get(t, {})}))
@@ -152,6 +152,24 @@ def test_good_sequence_writes_and_reads_back():
     assert out[78] == (0xBEEF, 0xFFFF)                                 # CL 2: driven in cycle 77 + 1
     assert out[79] == ((power_up_word(a6) & 0xFF00) | 0x34, 0xFFFF)
     assert chip.word(a5) == 0xBEEF and chip.stats.ready_edge == 70
+    assert chip.write_log == [] and chip.read_log == []               # not recorded unless asked
+
+
+def test_access_logs_and_reads_in_flight():
+    """``record``: every write (its edge, address and the word after it, masked bytes kept) and every read
+    (the READ's edge and address), the benches' source for checking reads; ``pending`` names reads in flight."""
+    s = init_seq()
+    s[72] = cmd("ACT", ba=2, a=9)
+    s[75] = cmd("WRITE", ba=2, a=3, dq_oe=1, dq_o=0xA5C3, dqm=1)      # lower byte masked
+    s[77] = cmd("READ", ba=2, a=3, dqm=0)
+    s[78] = cmd("READ", ba=2, a=4, dqm=0)
+    chip, _ = run({k: v for k, v in s.items() if k <= 77}, record=True)
+    a3, a4 = (9 * 4 + 2) * 1024 + 3, (9 * 4 + 2) * 1024 + 4
+    assert not chip.idle and chip.pending().startswith("1 reads in flight")   # driven in cycle 78
+    chip, _ = run(s, last=85, record=True)
+    assert chip.violations == [] and chip.idle and chip.pending().startswith("0 reads")
+    assert chip.write_log == [(75, a3, (power_up_word(a3) & 0x00FF) | 0xA500)]
+    assert chip.read_log == [(77, a3), (78, a4)]
 
 
 @pytest.mark.parametrize("change,rule", [
