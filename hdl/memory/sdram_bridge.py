@@ -25,8 +25,10 @@ def sdram_bridge(clk, rst, cmd, rsp, port, *, depth: int = 16):
     (row | bank | column): the SRAM's 1M-word map fits the lower 2^20 words.
 
     A write's data and byte enables wait in a show-ahead FIFO until the controller pulls them; a read's tag in
-    another until its word comes back. ``cmd.ready`` is low while the command register is full and the
-    controller does not take it, or while a FIFO is full.
+    another until its word comes back. The commands wait in two registers: the one the controller reads and a
+    skid register that takes a command while the controller holds back the first. So ``cmd.ready`` is a
+    flip-flop (the skid register empty, and room in both FIFOs for a word this clock even when none leaves):
+    the arbiter's grant logic does not wait for the controller's ``cmd_ready``.
 
     Ports:
         clk, rst: the memory clock; synchronous active-high reset (let the controller finish or reset it too).
@@ -36,10 +38,10 @@ def sdram_bridge(clk, rst, cmd, rsp, port, *, depth: int = 16):
         depth: entries of each FIFO (writes waiting for their data to be pulled; reads waiting for their word),
             2..64, default 16.
 
-    Latency: a command 1 clock in the bridge's register, then the controller's (docs/memory.md: a read on an open
-    row ``CL + 3`` clocks); read words pass straight through.
+    Latency: a command 1 clock in the bridge's register (2 when the controller held back the one before), then
+    the controller's (docs/memory.md: a read on an open row ``CL + 3`` clocks); read words pass straight through.
 
-    Resources: two LUT-RAM FIFOs (18 and ``tag_bits`` bits wide), the command register.
+    Resources: two LUT-RAM FIFOs (18 and ``tag_bits`` bits wide), the command register and the skid register.
     """
     check_clock(clk)
     check_reset(rst)
@@ -59,7 +61,10 @@ def sdram_bridge(clk, rst, cmd, rsp, port, *, depth: int = 16):
     dw, bw, tw = len(cmd.wdata), len(cmd.be), len(cmd.tag)
     s_valid, s_we = Signal(bool(0)), Signal(bool(0))
     s_addr = Signal(intbv(0)[len(port.cmd_addr):])
-    take = Signal(bool(0))
+    k_valid, k_we = Signal(bool(0)), Signal(bool(0))  # the skid register
+    k_addr = Signal(intbv(0)[len(port.cmd_addr):])
+    rdy = Signal(bool(0))  # cmd.ready, a register
+    take, moved = Signal(bool(0)), Signal(bool(0))
     w_in, w_out = Signal(intbv(0)[dw + bw:]), Signal(intbv(0)[dw + bw:])
     w_push, t_push = Signal(bool(0)), Signal(bool(0))
     w_level = Signal(intbv(0, min=0, max=depth + 1))
@@ -70,21 +75,36 @@ def sdram_bridge(clk, rst, cmd, rsp, port, *, depth: int = 16):
 
     @always_comb
     def handshake():
-        ready = (not s_valid or port.cmd_ready) and w_level < depth and t_level < depth
-        cmd.ready.next = ready
-        take.next = ready and cmd.valid
-        w_push.next = ready and cmd.valid and cmd.we
-        t_push.next = ready and cmd.valid and not cmd.we
+        cmd.ready.next = rdy
+        take.next = rdy and cmd.valid
+        w_push.next = rdy and cmd.valid and cmd.we
+        t_push.next = rdy and cmd.valid and not cmd.we
         w_in.next = concat(cmd.be, cmd.wdata)
+        moved.next = not s_valid or port.cmd_ready  # the controller's register is free at the next clock
 
     @always_seq(clk.posedge, reset=rst)
     def command():
-        if take:
-            s_valid.next = True
-            s_we.next = cmd.we
-            s_addr.next = cmd.addr
-        elif port.cmd_ready:
-            s_valid.next = False
+        skid = False
+        if moved:
+            # the skid register's command first (rdy is low while it is full: no command comes in then)
+            s_valid.next = k_valid or take
+            k_valid.next = False
+            if k_valid:
+                s_we.next = k_we
+                s_addr.next = k_addr
+            else:
+                s_we.next = cmd.we
+                s_addr.next = cmd.addr
+        elif take:
+            k_valid.next = True
+            k_we.next = cmd.we
+            k_addr.next = cmd.addr
+            skid = True
+        # ready at the next clock: the skid register empty then, and a FIFO below depth - 1 words now (or at
+        # depth - 1 with no word coming in), so a word taken at the next clock fits whatever leaves
+        w_room = w_level < depth - 1 or (w_level == depth - 1 and not w_push)
+        t_room = t_level < depth - 1 or (t_level == depth - 1 and not t_push)
+        rdy.next = not (skid or (k_valid and not moved)) and w_room and t_room
 
     @always_comb
     def to_controller():

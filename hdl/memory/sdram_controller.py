@@ -167,7 +167,12 @@ def sdram_controller(clk, rst, port, pins, *, part: str = ULX3S, clock_mhz: floa
     command taken (an ACTIVATE or PRECHARGE of either burst, PRECHARGE ALL) and set when the burst is
     taken from the port (the bank's row compared with the port's address).
     The command is decoded per bank from the burst that asked for it; no bank-address multiplexer sits
-    between the decision and the bank timers.
+    between the decision and the bank timers. The refresh's claim reads flags too (``run``: the power-up
+    sequence done; ``owed_any``, ``owed_many``: refreshes owed), and so does a burst's end (``cur_last``).
+    A burst on the port goes to the next-burst register only when there is none, so the stolen slot for
+    the next burst's bank cannot be in the way then: the choice between the two registers reads the
+    running burst's READ or WRITE without it, which keeps the next burst's bank flags off the path from
+    the port (the masters' command register, in ``sdram_subsystem``) into the burst flags.
 
     Ports:
         clk, rst: clock and synchronous active-high reset (restarts the power-up sequence).
@@ -193,11 +198,12 @@ def sdram_controller(clk, rst, port, pins, *, part: str = ULX3S, clock_mhz: floa
     Resources: the pin registers (about 40 flip-flops, for the I/O blocks), per bank an open flag, a row
     register, two timers and three timer flags, two burst registers (current and next) with two bank
     flags each, the refresh counter and the read-flag pipeline. Measured (docs/memory.md, AS4C32M16SB-7,
-    max_burst 8): 100 MHz CL 2: 536 LUT / 251 FF (Spartan-3E), 563 LUT4 / 251 FF (ECP5), ECP5-85 fmax 121.6 /
-    124.5 / 127.4 MHz (min / median / max over nextpnr seeds 1-4; before the registered flags 695 LUT4 / 252
-    FF and 88.0 MHz); 133 MHz CL 3: 629 LUT4 / 257 FF, 119.9 / 123.1 / 126.7 MHz (under its own clock: its
-    worst paths, the decision into the burst registers and the pin registers, are 6-8 LUTs with 6 ns of
-    routing; 133 MHz would need the decision registered, a clock more of latency).
+    max_burst 8): 100 MHz CL 2: 572 LUT / 255 FF (Spartan-3E), 573 LUT4 / 255 FF (ECP5), ECP5-85 fmax 119.9 /
+    125.8 / 126.2 MHz (min / median / max over nextpnr seeds 1-4; before the registered flags 695 LUT4 / 252
+    FF and 88.0 MHz); 133 MHz CL 3: 683 LUT4 / 261 FF, 122.4 / 130.6 / 132.8 MHz (under its own clock: its
+    worst paths, the decision into the bank timers and the pin registers, are 6-8 LUTs with 6 ns of
+    routing; 133 MHz would need the decision registered, a clock more of latency). In ``sdram_subsystem``
+    (max_burst 1, the arbiter before it) 118.6 / 125.6 / 131.2 MHz.
     """
     check_clock(clk)
     check_reset(rst)
@@ -212,6 +218,7 @@ def sdram_controller(clk, rst, port, pins, *, part: str = ULX3S, clock_mhz: floa
     margin = refresh_margin(ck)
     refi_max = ck.refi
     wait_max = max(ck.powerup, 1)
+    left_2 = min(2, nb_max)  # cur_left before the last word of a burst
 
     # --- the state ------------------------------------------------------------------------------------
     state = Signal(intbv(_WAIT, min=0, max=_RUN + 1))
@@ -220,6 +227,8 @@ def sdram_controller(clk, rst, port, pins, *, part: str = ULX3S, clock_mhz: floa
     refi = Signal(intbv(refi_max - 1, min=0, max=refi_max))
     refi_low = Signal(bool(0))  # refi < margin: a running burst must give way to the owed refresh
     owed = Signal(intbv(0, min=0, max=16))
+    # owed != 0, owed > 1 and state == _RUN as flip-flops: the refresh decision is one LUT from registers
+    owed_any, owed_many, run = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
     rrd = Signal(intbv(0, min=0, max=max(ck.rrd, 2)))
 
     is_open = [Signal(bool(0)) for _ in range(nbanks)]
@@ -239,6 +248,7 @@ def sdram_controller(clk, rst, port, pins, *, part: str = ULX3S, clock_mhz: floa
     cur_valid, cur_we, cur_started = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
     cur_bank, cur_row, cur_col = Signal(intbv(0)[bb:]), Signal(intbv(0)[rb:]), Signal(modbv(0)[cb:])
     cur_left = Signal(intbv(0, min=0, max=nb_max + 1))
+    cur_last = Signal(bool(0))  # cur_left == 1, from a flip-flop
     cur_open, cur_hit = Signal(bool(0)), Signal(bool(0))
     nxt_valid, nxt_we = Signal(bool(0)), Signal(bool(0))
     nxt_bank, nxt_row, nxt_col = Signal(intbv(0)[bb:]), Signal(intbv(0)[rb:]), Signal(intbv(0)[cb:])
@@ -253,13 +263,13 @@ def sdram_controller(clk, rst, port, pins, *, part: str = ULX3S, clock_mhz: floa
     # the decision of this clock: which command, for whom
     i_preall, i_ref, i_mrs, r_preall, r_ref = (Signal(bool(0)) for _ in range(5))
     go, cur_prep, nxt_prep = (Signal(bool(0)) for _ in range(3))
-    c_pre, c_act, n_pre, n_act, rw = (Signal(bool(0)) for _ in range(5))
+    c_pre, c_act, n_pre, n_act, rw, rw_cur = (Signal(bool(0)) for _ in range(6))
     d_cs, d_ras_n, d_cas_n, d_we_n = Signal(bool(0)), Signal(bool(1)), Signal(bool(1)), Signal(bool(1))
     d_preall, d_ref, d_mrs, d_rd, d_wr = (Signal(bool(0)) for _ in range(5))
     d_ba = Signal(intbv(0)[bb:])
     d_a = Signal(intbv(0)[ab:])
     act_row = Signal(intbv(0)[rb:])
-    take, load_cur, cur_end = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
+    take, load_cur, take_nxt = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
     rpipe = Signal(intbv(0)[cl + 1:])  # bit j: a READ was decided j + 1 clocks ago
 
     insts = []
@@ -288,7 +298,7 @@ def sdram_controller(clk, rst, port, pins, *, part: str = ULX3S, clock_mhz: floa
     @always_comb
     def status():
         wblock.next = rpipe != 0
-        port.cmd_ready.next = state == _RUN and not nxt_valid
+        port.cmd_ready.next = run and not nxt_valid
 
     @always_comb
     def bank_flags():
@@ -306,7 +316,7 @@ def sdram_controller(clk, rst, port, pins, *, part: str = ULX3S, clock_mhz: floa
     @always_comb
     def refresh_due():
         # refresh ahead of any burst not started, or of a running one when the next refresh is close
-        ref_now.next = state == _RUN and owed != 0 and (not cur_started or owed > 1 or refi_low)
+        ref_now.next = run and owed_any and (not cur_started or owed_many or refi_low)
 
     @always_comb
     def wants():
@@ -316,7 +326,7 @@ def sdram_controller(clk, rst, port, pins, *, part: str = ULX3S, clock_mhz: floa
         # a refresh: close every row, then AUTO REFRESH
         r_preall.next = ref_now and any_open and all_pok
         r_ref.next = ref_now and not any_open and all_aok
-        go.next = state == _RUN and not ref_now
+        go.next = run and not ref_now
         # the running burst's bank needs a PRECHARGE (row miss) or an ACTIVATE (idle), and it may go
         cur_prep.next = cur_valid and not cur_hit and ((cur_open and cur_pok) or (not cur_open and cur_aok and rrd_ok))
         # the next burst's bank, another one, the same (bank interleaving)
@@ -329,8 +339,10 @@ def sdram_controller(clk, rst, port, pins, *, part: str = ULX3S, clock_mhz: floa
         c_act.next = go and cur_prep and not cur_open
         n_pre.next = go and not cur_prep and nxt_prep and nxt_open
         n_act.next = go and not cur_prep and nxt_prep and not nxt_open
-        # (cur_hit rules out cur_prep)
-        rw.next = go and cur_valid and cur_hit and cur_rok and not (cur_we and wblock) and not nxt_prep
+        # (cur_hit rules out cur_prep) the running burst's READ or WRITE may go, unless the next burst's
+        # bank takes the slot
+        rw_cur.next = go and cur_valid and cur_hit and cur_rok and not (cur_we and wblock)
+        rw.next = rw_cur and not nxt_prep
 
     @always_comb
     def command():
@@ -367,9 +379,12 @@ def sdram_controller(clk, rst, port, pins, *, part: str = ULX3S, clock_mhz: floa
     @always_comb
     def handshake():
         port.wr_ready.next = d_wr
-        take.next = port.cmd_valid and state == _RUN and not nxt_valid
-        cur_end.next = rw and cur_left == 1
-        load_cur.next = (not cur_valid) or (rw and cur_left == 1)
+        take.next = port.cmd_valid and run and not nxt_valid
+        load_cur.next = (not cur_valid) or (rw and cur_last)
+        # a burst taken goes to the next-burst register when the running one does not end in this clock;
+        # take implies no next burst, hence no nxt_prep: rw_cur stands for rw here, which keeps the next
+        # burst's bank flags (and the stolen slot) off this path from the port into the burst flags
+        take_nxt.next = take and cur_valid and not (rw_cur and cur_last)
 
     insts += [fields_in, port_flags, status, bank_flags, refresh_due, wants, decide, command, row_of_act, address,
               handshake]
@@ -396,6 +411,7 @@ def sdram_controller(clk, rst, port, pins, *, part: str = ULX3S, clock_mhz: floa
         elif state == _MRDW:
             if icnt == 0:
                 state.next = _RUN
+                run.next = True
             else:
                 icnt.next = icnt - 1
         refi_low.next = state == _RUN and refi != 0 and refi <= margin
@@ -403,12 +419,16 @@ def sdram_controller(clk, rst, port, pins, *, part: str = ULX3S, clock_mhz: floa
             refi.next = refi_max - 1
         elif refi == 0:
             refi.next = refi_max - 1
-            if not (d_ref and owed != 0) and owed != 15:
+            if not (d_ref and owed_any) and owed != 15:
                 owed.next = owed + 1
+                owed_any.next = True
+                owed_many.next = owed_any
         else:
             refi.next = refi - 1
-            if d_ref and owed != 0:
+            if d_ref and owed_any:
                 owed.next = owed - 1
+                owed_any.next = owed_many
+                owed_many.next = owed > 2
         if c_act or n_act:
             rrd.next = ck.rrd - 1
         elif rrd != 0:
@@ -425,6 +445,7 @@ def sdram_controller(clk, rst, port, pins, *, part: str = ULX3S, clock_mhz: floa
                 cur_row.next = nxt_row
                 cur_col.next = nxt_col
                 cur_left.next = nxt_len
+                cur_last.next = nxt_len == 1
                 cur_open.next = nxt_open
                 cur_hit.next = nxt_hit
                 cur_started.next = False
@@ -437,6 +458,7 @@ def sdram_controller(clk, rst, port, pins, *, part: str = ULX3S, clock_mhz: floa
                 cur_row.next = in_row
                 cur_col.next = in_col
                 cur_left.next = port.cmd_len
+                cur_last.next = port.cmd_len == 1
                 cur_open.next = in_open and not d_preall
                 cur_hit.next = in_hit and not d_preall
                 cur_started.next = False
@@ -447,10 +469,13 @@ def sdram_controller(clk, rst, port, pins, *, part: str = ULX3S, clock_mhz: floa
             if rw:
                 cur_col.next = cur_col + 1
                 cur_left.next = cur_left - 1
+                # (with max_burst 1 a READ or WRITE always ends its burst and this never runs; the constant
+                # stays inside cur_left's range, which GHDL's synthesis needs)
+                cur_last.next = cur_left == left_2
                 cur_started.next = True
             cur_open.next = (cur_open or c_act) and not c_pre and not d_preall
             cur_hit.next = (cur_hit or c_act) and not c_pre and not d_preall
-        if take and not load_cur:
+        if take_nxt:
             # (the clock's command is the running burst's or a refresh's)
             nxt_valid.next = True
             nxt_we.next = port.cmd_we

@@ -19,7 +19,7 @@ def sdram_subsystem(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, sd
                     part: str = ULX3S, clock_mhz: float = 100.0, cas_latency: int = 2, width: int = 352,
                     height: int = 288,
                     feature_words: int = 8192, depth: int = 16, burst: int = 8, fetch_burst: int = 8,
-                    host_burst: int = 1, counter_bits: int = 32):
+                    host_burst: int = 1, counter_bits: int = 32, cameras: bool = True):
     """The arbiter's six masters on an SDRAM: :func:`~eyestereo.hdl.memory.sram_arbiter.sram_arbiter` ->
     :func:`~eyestereo.hdl.memory.sdram_bridge.sdram_bridge` ->
     :func:`~eyestereo.hdl.memory.sdram_controller.sdram_controller`: the same masters, frame handshake, status
@@ -40,7 +40,8 @@ def sdram_subsystem(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, sd
 
     Parameters:
         part, clock_mhz, cas_latency: the SDRAM part and its clock (:func:`sdram_controller`).
-        width, height, feature_words, depth, burst, fetch_burst, host_burst, counter_bits: as :func:`sram_arbiter`.
+        width, height, feature_words, depth, burst, fetch_burst, host_burst, counter_bits, cameras: as
+            :func:`sram_arbiter`.
 
     Latency: the arbiter's and the controller's: a host read on an open row about 5 clocks more than on the SRAM.
 
@@ -48,7 +49,7 @@ def sdram_subsystem(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, sd
     """
     check_masters(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, width=width, height=height,
                   feature_words=feature_words, depth=depth, burst=burst, fetch_burst=fetch_burst,
-                  host_burst=host_burst, counter_bits=counter_bits)
+                  host_burst=host_burst, counter_bits=counter_bits, cameras=cameras)
     check_bundle("sdram", sdram, SdramPins)
     outs = dict(fetch=fetch, stat=stat, sdram=sdram)
     if ready is not None:
@@ -66,7 +67,7 @@ def sdram_subsystem(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, sd
     port = SdramPort(p.addr_bits, 1, p.data_bits)
     arb = sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, rsp, width=width,
                        height=height, feature_words=feature_words, depth=depth, burst=burst,
-                       fetch_burst=fetch_burst, host_burst=host_burst, counter_bits=counter_bits)
+                       fetch_burst=fetch_burst, host_burst=host_burst, counter_bits=counter_bits, cameras=cameras)
     bridge = sdram_bridge(clk, rst, cmd, rsp, port)
     ctrl = sdram_controller(clk, rst, port, sdram, part=part, clock_mhz=clock_mhz, cas_latency=cas_latency,
                             max_burst=1)

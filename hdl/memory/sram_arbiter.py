@@ -2,8 +2,8 @@
 
 from myhdl import ConcatSignal, Signal, always, always_comb, always_seq, block, concat, downrange, intbv
 
-from eyestereo.hdl.common.checks import (block_error, check_choice, check_clock, check_distinct, check_frame,
-                                         check_int, check_reset, check_stream)
+from eyestereo.hdl.common.checks import (block_error, check_bool, check_choice, check_clock, check_distinct,
+                                         check_frame, check_int, check_reset, check_stream)
 from eyestereo.hdl.common.packed import unpack_word
 from eyestereo.hdl.common.registers import assign
 from eyestereo.hdl.interfaces.fetch_port import check_fetch
@@ -30,7 +30,7 @@ def _check_port(master, port) -> None:
 
 
 def check_masters(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, *, width, height, feature_words, depth,
-                  burst, fetch_burst, host_burst, counter_bits) -> tuple:
+                  burst, fetch_burst, host_burst, counter_bits, cameras=True) -> tuple:
     """The masters' ports and the arbiter's parameters (shared by :func:`sram_arbiter` and the subsystem,
     so that the block a user instantiates names itself in the message); returns the parameters as ints
     and the address map."""
@@ -55,7 +55,7 @@ def check_masters(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, *, w
         raise block_error(f"port stat needs at least 5 address bits and 32 data bits, got {len(stat.addr)} and "
                           f"{len(stat.data)}")
     try:
-        amap = AddressMap(width, height, feature_words)
+        amap = AddressMap(width, height, feature_words, cameras=check_bool("cameras", cameras))
     except ValueError as e:
         raise block_error(f"parameters width, height, feature_words: {e}") from None
     return width, height, feature_words, depth, burst, fetch_burst, host_burst, counter_bits, amap
@@ -77,7 +77,7 @@ def counter(clk, rst, inc, q):
 @block
 def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, rsp, *, width: int = 352,
                  height: int = 288, feature_words: int = 8192, depth: int = 16, burst: int = 8,
-                 fetch_burst: int = 8, host_burst: int = 1, counter_bits: int = 32):
+                 fetch_burst: int = 8, host_burst: int = 1, counter_bits: int = 32, cameras: bool = True):
     """Six masters, each a port of its own kind, share one SRAM word port, with double-buffered frames.
 
     Masters (index, port): 0, 1 ``cam0``/``cam1`` -- camera writers (queue read ports of 16-bit camera
@@ -133,6 +133,8 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
         depth: writer FIFO depth (8, 16 or 32 words of LUT-RAM).
         burst: writer burst length (2..depth/2), fetch_burst (4..16), host_burst (1..8, default 1).
         counter_bits: width of the words-moved and clocks-waited counters (16..32).
+        cameras: the camera buffers in the address map (default); False: none (``rectify="stream"``: the camera
+            writers idle, the rectified buffers from address 0; AddressMap's ``cameras``).
 
     Latency (measured, docs/sram.md): on a quiet bus with a part of read latency 2, a fetch request's
     first pixel comes 11 clocks after the request is taken, a host read's word 7 clocks after; each
@@ -144,7 +146,7 @@ def sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, 
     width, height, feature_words, depth, burst, fetch_burst, host_burst, counter_bits, amap = check_masters(
         clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, width=width, height=height,
         feature_words=feature_words, depth=depth, burst=burst, fetch_burst=fetch_burst, host_burst=host_burst,
-        counter_bits=counter_bits)
+        counter_bits=counter_bits, cameras=cameras)
     check_bundle("cmd", cmd, SramCmd)
     check_bundle("rsp", rsp, SramRsp)
     if cmd.tag_bits != TAG_BITS or rsp.tag_bits != TAG_BITS:

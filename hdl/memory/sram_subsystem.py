@@ -13,7 +13,7 @@ from eyestereo.tools.sram import KINDS
 def sram_subsystem(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, sram, *, kind: str = "nobl",
                    read_latency: int = 2, width: int = 352, height: int = 288, feature_words: int = 8192,
                    depth: int = 16, burst: int = 8, fetch_burst: int = 8, host_burst: int = 1,
-                   counter_bits: int = 32):
+                   counter_bits: int = 32, cameras: bool = True):
     """:func:`~eyestereo.hdl.memory.sram_arbiter.sram_arbiter` on
     :func:`~eyestereo.hdl.memory.sram_controller.sram_controller`.
 
@@ -26,7 +26,7 @@ def sram_subsystem(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, sra
 
     Parameters:
         kind, read_latency: the part (:func:`sram_controller`).
-        width, height, feature_words, depth, burst, fetch_burst, host_burst, counter_bits: as
+        width, height, feature_words, depth, burst, fetch_burst, host_burst, counter_bits, cameras: as
             :func:`sram_arbiter`.
 
     Latency: as :func:`sram_arbiter` (measured with a part of read latency 2: fetch 11 clocks to the
@@ -37,7 +37,7 @@ def sram_subsystem(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, sra
     # every check here, so that a message names this block (not the arbiter or controller inside)
     check_masters(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, width=width, height=height,
                   feature_words=feature_words, depth=depth, burst=burst, fetch_burst=fetch_burst,
-                  host_burst=host_burst, counter_bits=counter_bits)
+                  host_burst=host_burst, counter_bits=counter_bits, cameras=cameras)
     check_bundle("sram", sram, SramPins)
     check_distinct(dict(fetch=fetch, stat=stat, sram=sram), dict(clk=clk, rst=rst, cam0=cam0, cam1=cam1, rect=rect,
                                                                feat=feat, host=host, ctl=ctl))
@@ -47,6 +47,6 @@ def sram_subsystem(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, sra
     rsp = SramRsp(tag_bits=TAG_BITS)
     arb = sram_arbiter(clk, rst, cam0, cam1, fetch, rect, feat, host, ctl, stat, cmd, rsp, width=width,
                        height=height, feature_words=feature_words, depth=depth, burst=burst,
-                       fetch_burst=fetch_burst, host_burst=host_burst, counter_bits=counter_bits)
+                       fetch_burst=fetch_burst, host_burst=host_burst, counter_bits=counter_bits, cameras=cameras)
     ctrl = sram_controller(clk, rst, cmd, rsp, sram, kind=kind, read_latency=read_latency)
     return arb, ctrl

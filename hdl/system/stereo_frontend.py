@@ -118,7 +118,8 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
             rectifier fetches its 2x2 neighbourhoods from there (about 1.9 reads per pixel); ``"stream"``: the
             cameras' words go straight into :func:`~eyestereo.hdl.rectify.stream_rectifier.stream_rectifier` (a
             line cache of ``cache_lines`` lines per camera in block RAM), which rectifies each frame as it
-            arrives: no camera frames and no rectifier reads in the SRAM, the camera buffers stay empty. The
+            arrives: no camera frames and no rectifier reads in the SRAM; the address map has no camera buffers
+            (AddressMap's ``cameras=False``: the rectified buffers from address 0, so 640x480 fits the 1M words). The
             sequencer's modes are the same: a stereo frame is "held" when both cameras have begun one (the
             sequential mode's arming waits for frames that begin after it); a frame whose lines the cameras
             overwrote before the rectifier read them (the cache too small, or the cameras too far apart) still
@@ -202,10 +203,11 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     if memory == "sram":
         insts.append(sram_subsystem(clk, rst, m_cam0, m_cam1, fetch, rect, feat, host, ctl, stat, sram, kind=kind,
                                     read_latency=read_latency, width=width, height=height,
-                                    feature_words=feature_words))
+                                    feature_words=feature_words, cameras=not stream))
     else:
         insts.append(sdram_subsystem(clk, rst, m_cam0, m_cam1, fetch, rect, feat, host, ctl, stat, sram, mem_ready,
-                                     part=sdram_part, width=width, height=height, feature_words=feature_words))
+                                     part=sdram_part, width=width, height=height, feature_words=feature_words,
+                                     cameras=not stream))
     insts.append(register_bank(clk, rst, bus, regs, stat, fcount, host, width=width, height=height))
 
     # ---- rectifier and sequencer -----------------------------------------------------------------

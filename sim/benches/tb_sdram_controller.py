@@ -7,10 +7,12 @@ the whole power-up sequence again), random bursts are offered on the burst port,
 ``random``  (the regression) sequential runs of bursts of random length across rows and banks, bursts at
             random places in a few rows per bank (row hits, misses and bank conflicts), random single words,
             now and then anywhere in the part; reads and writes mixed, byte masks, idle gaps, long pauses.
-``seq8``, ``row``, ``mixed``, ``single``  (bandwidth, :mod:`eyestereo.sim.measure.bench_sdram`) reads in
-            sequential bursts of 8, reads of whole rows, write and read bursts of 8 taking turns (two
-            sequential streams, the reader one bank ahead), reads of single words at random addresses;
-            offered without pause for ``clocks`` clocks after the power-up sequence.
+``seq8``, ``row``, ``mixed``, ``single``, ``seq1``, ``wseq1``  (bandwidth,
+            :mod:`eyestereo.sim.measure.bench_sdram`) reads in sequential bursts of 8, reads of whole rows,
+            write and read bursts of 8 taking turns (two sequential streams, the reader one bank ahead), reads
+            of single words at random addresses, reads and writes of single words at sequential addresses
+            (the SRAM arbiter's words through ``sdram_bridge``); offered without pause for ``clocks`` clocks
+            after the power-up sequence.
 ``latency``  single words far apart (:func:`latency_traffic`): a write to an idle bank, reads on an open row,
             an idle bank and a row miss, a write on an open row; each one's clocks from the command taken to
             its first word (``rd_valid``) or ``wr_ready`` asserted equal to the documented latency.
@@ -130,7 +132,11 @@ def pattern_traffic(rng: random.Random, p, pattern: str, n: int) -> list[Burst]:
         return out
     if pattern == "single":
         return [Burst(False, rng.randrange(p.words), 1) for _ in range(n)]
-    raise ValueError(f"unknown pattern {pattern!r}: random, seq8, row, mixed or single")
+    if pattern == "seq1":
+        return [Burst(False, i % p.words, 1) for i in range(n)]
+    if pattern == "wseq1":
+        return [Burst(True, i % p.words, 1, [rng.randrange(1 << p.data_bits)], [3]) for i in range(n)]
+    raise ValueError(f"unknown pattern {pattern!r}: random, seq8, row, mixed, single, seq1 or wseq1")
 
 
 def merge(old: int, data: int, be: int) -> int:

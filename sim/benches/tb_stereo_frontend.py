@@ -162,7 +162,8 @@ async def frames_bit_exact(dut):
     n_host = cfg.get("frames", 3)
     # sequential: each frame lets a few camera frames pass (arming, read-out): enough for every one
     n_cam = cfg.get("camera_frames", 5 * n_host + 4)
-    amap = AddressMap(w, h, cfg["params"].get("feature_words", 2048))
+    amap = AddressMap(w, h, cfg["params"].get("feature_words", 2048),
+                      cameras=cfg["params"].get("rectify", "fetch") != "stream")
     if cfg.get("pair") is not None:
         if cfg.get("images") is not None:
             raise ValueError("give the scene as images or as pair, not both")

@@ -9,7 +9,9 @@ the power-up sequence (the model checks every rule and the scoreboard every read
 * ``seq8``: reads in sequential bursts of 8 words (row after row, bank after bank);
 * ``row``: reads of whole rows (1024-word bursts);
 * ``mixed``: a writer and a reader taking turns with bursts of 8, each sequential, one bank apart;
-* ``single``: reads of single words at random addresses (a row miss almost every time).
+* ``single``: reads of single words at random addresses (a row miss almost every time);
+* ``seq1``, ``wseq1``: reads, writes of single words at sequential addresses (one-word bursts, as
+  ``sdram_bridge`` gives the SRAM arbiter's words).
 
 Words per clock count every word the port moved in the window (read words returned, write words taken);
 MB/s is that times 2 bytes times the clock. ``--synth`` adds the controller's resources (Yosys: Spartan-3E
@@ -29,9 +31,10 @@ from eyestereo.tools.sdram import ULX3S, part as sdram_part
 
 NAME = "sdram_controller"
 
-PATTERNS = ("seq8", "row", "mixed", "single")
+PATTERNS = ("seq8", "row", "mixed", "single", "seq1", "wseq1")
 WHAT = {"seq8": "reads, sequential bursts of 8", "row": "reads, whole rows (1024 words)",
-        "mixed": "write 8 / read 8 in turn, two sequential streams", "single": "reads, single words, random addresses"}
+        "mixed": "write 8 / read 8 in turn, two sequential streams", "single": "reads, single words, random addresses",
+        "seq1": "reads, single words, sequential addresses", "wseq1": "writes, single words, sequential addresses"}
 CLOCKS = ((100.0, 2), (133.0, 3))
 BEGIN, END = "<!-- bench_sdram: begin -->", "<!-- bench_sdram: end -->"
 

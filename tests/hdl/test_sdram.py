@@ -58,6 +58,22 @@ def test_random_long_bursts_32mb_part(request):
                 dict(seeds=list(seeds), bursts=100)), seeds)
 
 
+def test_one_word_bursts(request):
+    """max_burst 1, as sdram_subsystem builds it (the SRAM arbiter's words through sdram_bridge): random traffic
+    for 6 seeds, then single words at sequential addresses, reads and writes: a word per clock on an open row,
+    less the refreshes (PRECHARGE ALL, tRP, tRFC: about 10 clocks each 100 here) and the row changes."""
+    seeds = range(51, 57)
+    params = dict(part=FAST, clock_mhz=100.0, cas_latency=2, max_burst=1)
+    _check(_run(request, params, dict(seeds=list(seeds), bursts=300)), seeds)
+    runs = run_bench("sdram_controller", "tb_sdram_controller",
+                     dict(patterns=["seq1", "wseq1"], seeds=[1], clocks=3000),
+                     name=request.node.name + "_sequential", params=params)["runs"]
+    for r in runs:
+        words = r["words_read"] + r["words_written"]
+        assert r["violations"] == [] and r["late"] == 0 and r["refreshes"] >= 25, r
+        assert 0.8 < words / r["clocks"] <= 1.0, (r["pattern"], words, r["clocks"])
+
+
 def test_real_figures_several_refreshes(request):
     """The ULX3S's part as the datasheet gives it: the 200 us power-up wait, tREFI 7.8 us; traffic, then a
     quiet stretch, 60 us in all: the controller keeps refreshing with nothing to do."""

@@ -100,3 +100,17 @@ def test_scoreboard_bytes_and_power_up():
     assert sb.read(7) == 0xAA55
     sb.write(7, 0x1200, be=2)
     assert sb.peek(7) == 0x1255 and sb.writes == 3 and sb.reads == 2
+
+
+def test_the_map_without_camera_buffers():
+    """cameras=False (rectify="stream"): the rectified buffers from 0, the lists after them; VGA fits the 1M words
+    (2 x 307,200 + 2 x 8,192 = 630,784), which it does not with the camera buffers (6 x 307,200 = 1,843,200)."""
+    m = AddressMap(640, 480, 8192, cameras=False)
+    assert (m.rectified(0), m.rectified(1)) == (0, 307_200)
+    assert (m.features(0), m.features(1)) == (614_400, 622_592) and m.host_base == 630_784
+    assert m.bases("cam0") == (0, 0)
+    with pytest.raises(ValueError, match="no camera buffers"):
+        m.camera(0, 0)
+    assert [r[0] for r in m.regions()][:2] == ["rectified buffer 0", "rectified buffer 1"]
+    with pytest.raises(ValueError, match="need 1859584 words"):
+        AddressMap(640, 480, 8192)

@@ -97,12 +97,17 @@ class AddressMap:
     feature list, buffer b  ``feature_words`` each (2)    the list's words in order
     host area               the rest up to 1M             free for the host's own use
     ======================  ============================  ===============================================
+
+    ``cameras=False`` (the front end's ``rectify="stream"``: the cameras go to the line cache, not the memory): no
+    camera buffers, the rectified buffers from address 0 and the rest moved down with them, so that 640x480
+    frames fit the 1M words too (2 x 307,200 + the lists). The camera writers' bases are then 0 (they never write).
     """
 
     width: int = FRAME_WIDTH
     height: int = FRAME_HEIGHT
     feature_words: int = 8192
     words: int = WORDS
+    cameras: bool = True
 
     def __post_init__(self):
         for name in ("width", "height", "feature_words"):
@@ -110,8 +115,14 @@ class AddressMap:
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 2:
                 raise ValueError(f"AddressMap {name} must be an int >= 2, got {v!r}")
         if self.host_base > self.words:
-            raise ValueError(f"{self.width}x{self.height} frames: 6 buffers of {self.frame} words and 2 feature "
-                             f"lists of {self.feature_words} need {self.host_base} words, the SRAM has {self.words}")
+            raise ValueError(f"{self.width}x{self.height} frames: {self._frames} buffers of {self.frame} words and 2 "
+                             f"feature lists of {self.feature_words} need {self.host_base} words, the SRAM has "
+                             f"{self.words}")
+
+    @property
+    def _frames(self) -> int:
+        """Frame buffers in the map: 4 camera and 2 rectified, or the 2 rectified alone."""
+        return 6 if self.cameras else 2
 
     @property
     def frame(self) -> int:
@@ -120,19 +131,23 @@ class AddressMap:
     def camera(self, cam: int, buf: int) -> int:
         """Base address of camera ``cam``'s buffer ``buf``."""
         self._check(cam, buf)
+        if not self.cameras:
+            raise ValueError("this map has no camera buffers (cameras=False)")
         return (2 * cam + buf) * self.frame
 
     def rectified(self, buf: int) -> int:
         self._check(0, buf)
-        return (4 + buf) * self.frame
+        return (self._frames - 2 + buf) * self.frame
 
     def features(self, buf: int) -> int:
         self._check(0, buf)
-        return 6 * self.frame + buf * self.feature_words
+        return self._frames * self.frame + buf * self.feature_words
 
     def bases(self, writer: str) -> tuple[int, int]:
         """Base addresses of the two buffers of ``writer`` (a name of :data:`WRITERS`)."""
         if writer in ("cam0", "cam1"):
+            if not self.cameras:
+                return 0, 0
             return self.camera(int(writer[-1]), 0), self.camera(int(writer[-1]), 1)
         if writer == "rect":
             return self.rectified(0), self.rectified(1)
@@ -147,7 +162,7 @@ class AddressMap:
 
     @property
     def host_base(self) -> int:
-        return 6 * self.frame + 2 * self.feature_words
+        return self._frames * self.frame + 2 * self.feature_words
 
     def pixel(self, base: int, x, y):
         """Address of pixel (x, y) in the frame buffer at ``base`` (numpy arrays welcome)."""
@@ -155,7 +170,8 @@ class AddressMap:
 
     def regions(self) -> list[tuple[str, int, int]]:
         """(name, first address, words) of every region, in address order."""
-        out = [(f"camera {c} buffer {b}", self.camera(c, b), self.frame) for c in (0, 1) for b in (0, 1)]
+        out = [(f"camera {c} buffer {b}", self.camera(c, b), self.frame) for c in (0, 1) for b in (0, 1)
+               if self.cameras]
         out += [(f"rectified buffer {b}", self.rectified(b), self.frame) for b in (0, 1)]
         out += [(f"feature list {b}", self.features(b), self.feature_words) for b in (0, 1)]
         out.append(("host area", self.host_base, self.words - self.host_base))
