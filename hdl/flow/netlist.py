@@ -121,14 +121,26 @@ def fix_arithmetic_shifts(verilog: str) -> tuple[str, int]:
     return _ASR.subn(r"\1 >>> ", verilog)
 
 
+_NORW = re.compile(r"^(\s*)(reg \[\d+:\d+\] \w+_norw\[\d+:\d+\]\s*;)", re.M)
+
+
+def mark_no_rw_check(verilog: str) -> tuple[str, int]:
+    """``(* no_rw_check *)`` on every memory whose MyHDL name ends in ``_norw``: a block promises by that name that
+    it never reads an address in the clock it writes it (hdl/rectify/line_cache.py), so Yosys need not build the
+    logic that emulates such a collision between a block RAM's two ports (a LUT between the RAM and its register)."""
+    return _NORW.subn(r"\1(* no_rw_check *) \2", verilog)
+
+
 def repair(verilog: str, vhdl_netlist: str) -> tuple[str, dict[str, int]]:
-    """Both repairs of a GHDL 2.0 Verilog netlist; the text and how many of each were made."""
+    """The repairs of a GHDL 2.0 Verilog netlist (and the ``_norw`` memories marked); the text and how many of each
+    were made."""
     bad = _UNSUPPORTED.search(verilog)
     if bad:
         raise NetlistError(f"GHDL's Verilog netlist has a construct it writes wrongly: {bad.group(0)!r}")
     text, shifts = fix_arithmetic_shifts(verilog)
     text, defaults = patch_pmux_defaults(text, vhdl_select_defaults(vhdl_netlist))
-    return text, dict(arithmetic_shifts=shifts, case_defaults=defaults)
+    text, norw = mark_no_rw_check(text)
+    return text, dict(arithmetic_shifts=shifts, case_defaults=defaults, no_rw_check=norw)
 
 
 _DECL = re.compile(r"^\s*(?:signal\s+|variable\s+)?(\w+)\s*:\s*(?:in\s+|out\s+|inout\s+|buffer\s+)?"

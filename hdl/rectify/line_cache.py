@@ -127,7 +127,9 @@ def line_cache(clk, rst, cam0, cam1, fetch, start, run, arm, begun, overrun, *, 
     @block
     def bank(we, waddr, wdata, q, *, index):
         """One block RAM of the ring: BANK bytes, written where ``waddr`` falls in it, read at ``r_lo``."""
-        mem = [Signal(intbv(0)[8:]) for _ in range(BANK)]
+        # "_norw": never read at the address written in the same clock (a fetch reads complete lines, the camera
+        # writes the next one), so the flow tells Yosys to leave out its collision logic (hdl/flow/netlist.py)
+        mem_norw = [Signal(intbv(0)[8:]) for _ in range(BANK)]
         sel = Signal(bool(0))
         w_lo = Signal(intbv(0)[BANK_BITS:])
         d = Signal(intbv(0)[8:])
@@ -141,8 +143,8 @@ def line_cache(clk, rst, cam0, cam1, fetch, start, run, arm, begun, overrun, *, 
         def ram():
             # no reset: a memory with a reset is not a block RAM
             if sel:
-                mem[w_lo].next = wdata
-            d.next = mem[r_lo]
+                mem_norw[w_lo].next = wdata
+            d.next = mem_norw[r_lo]
 
         @always(clk.posedge)
         def out():

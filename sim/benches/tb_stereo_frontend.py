@@ -290,13 +290,17 @@ async def frames_bit_exact(dut):
         await drv.wait_frame(after=n, timeout_clocks=timeout, poll_clocks=200)
         t_frame = get_sim_time(unit="ns")
         await drv.set(rect_want=1, feat_want=1)
-        for _ in range(2000):
+        # a pair comes within a camera frame or two (overlapped: the writer may be filling the free buffer); wait
+        # three camera frames of the slowest camera (at least 2 ms, the bound before VGA), polling every 50 clocks
+        cam_ns = timing.frame_pclk * 1e3 / min(cfg.get("cam_l_mhz", 18.0), cfg.get("cam_r_mhz", 17.9))
+        deadline = get_sim_time(unit="ns") + max(3 * cam_ns, 2e6)
+        while True:
             st = await drv.status()
             if st["rect_held"] and st["feat_held"]:
                 break
+            if get_sim_time(unit="ns") > deadline:
+                raise AssertionError(f"frame {n}: the host never got the rectified pair and the lists ({st})")
             await bus.wait(50)
-        else:
-            raise AssertionError(f"frame {n}: the host never got the rectified pair and the lists ({st})")
         await drv.set(rect_want=0, feat_want=0)
         tot = await drv.read("FEATURES")
         counts = await drv.feature_counts()

@@ -59,6 +59,8 @@ def synth_rows(path: Path | None) -> list[list]:
         return []
     rows = []
     for r in json.loads((path / "resources.json").read_text()):
+        if r["block"] not in ("line_cache", "stream_rectifier"):
+            continue
         sm, e, f = r.get("summary", {}), r.get("ecp5", {}), r.get("fmax", {}).get("clk", {})
         rows.append([r["label"], sm.get("LUT", ""), sm.get("RAMB16", ""), sm.get("MULT18X18", ""),
                      f"{e.get('TRELLIS_COMB', '')} / {e.get('TRELLIS_FF', '')} / {e.get('DP16KD', 0)} / "

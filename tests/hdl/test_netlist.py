@@ -73,7 +73,7 @@ def test_repair_refuses_what_it_cannot_map():
     with pytest.raises(NetlistError, match="writes wrongly"):
         repair("  assign n1_o = a % b; // smod\n", "")
     text, counts = repair(VERILOG, VHDL)
-    assert counts == dict(arithmetic_shifts=1, case_defaults=2)
+    assert counts == dict(arithmetic_shifts=1, case_defaults=2, no_rw_check=0)
 
 
 def test_lint_refuses_comparisons_ghdl_synthesizes_wrongly(tmp_path):
@@ -154,3 +154,12 @@ def test_harris_mono_netlist_full_frame(request):
     _run("harris_mono", "tb_harris_mono",
          dict(width=FRAME_WIDTH, height=FRAME_HEIGHT, blocks=THRESHOLD_BLOCKS, nms=NMS_DEFAULT),
          dict(frames=["file:tsukuba_im3.png"], duty=1.0, k=K_CODE_DEFAULT, thresholds=thr), request)
+
+
+def test_norw_memories_are_marked_for_yosys():
+    from eyestereo.hdl.flow.netlist import mark_no_rw_check
+
+    text = "  reg [7:0] a_bank0_mem_norw[2047:0] ; // memory\n  reg [7:0] fifo_mem[15:0] ; // memory\n"
+    out, n = mark_no_rw_check(text)
+    assert n == 1
+    assert "(* no_rw_check *) reg [7:0] a_bank0_mem_norw[2047:0] ;" in out and "\n  reg [7:0] fifo_mem[15:0]" in out
