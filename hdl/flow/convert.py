@@ -42,6 +42,17 @@ def vhdl93_literals(text: str) -> str:
     return _SIZED_LITERAL.sub(_plain_literal, text)
 
 
+def fresh_names() -> None:
+    """Forget the block names MyHDL has handed out in this process. MyHDL makes each instance name unique over the
+    whole process by appending ``_0``, ``_1``, ... to it, every repeat again: in a test worker that has converted the
+    front end a dozen times, nested blocks' names passed GHDL's 1023-character limit (issue 26). Each conversion is
+    its own design, so its names need only be unique within it."""
+    import myhdl._block as mb
+
+    mb._name_set.clear()
+    mb._inst_name_set.clear()
+
+
 def convert(name: str, path: Path, *, hdl: str = "VHDL", entity: str | None = None, timescale: str | None = None,
             **params) -> list[Path]:
     """Convert one block (fresh instance) into ``path``; returns the files written (package first).
@@ -54,6 +65,7 @@ def convert(name: str, path: Path, *, hdl: str = "VHDL", entity: str | None = No
     spec = get(name)
     path = Path(path)
     path.mkdir(parents=True, exist_ok=True)
+    fresh_names()
     inst, _, _ = spec.elaborate(**params)
     entity = entity or spec.name
     with warnings.catch_warnings():
