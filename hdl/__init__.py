@@ -28,6 +28,7 @@ _EXPORTS = {
     "cornerness": "harris.cornerness",
     "prethreshold": "harris.prethreshold",
     "nms": "harris.nms",
+    "census": "dense.census",
     "harris_mono": "harris.harris_mono",
     "harris_stereo": "harris.harris_stereo",
     "feature_list": "harris.feature_list",

@@ -29,6 +29,7 @@ from eyestereo.hdl.camera.camera_stream import camera_stream
 from eyestereo.hdl.interfaces.axis import AxiStream
 from eyestereo.hdl.axi.axis_to_stream import axis_to_stream
 from eyestereo.hdl.streaming.convolve import convolve
+from eyestereo.hdl.dense.census import census
 from eyestereo.hdl.harris.cornerness import cornerness
 from eyestereo.hdl.harris.harris_mono import harris_mono
 from eyestereo.hdl.harris.harris_stereo import harris_stereo
@@ -68,6 +69,7 @@ from eyestereo.hdl.streaming.word_cdc import word_cdc
 from eyestereo.tools.camera import WORD as CAMERA_WORD
 from eyestereo.hdl.axi.stream_to_axis import stream_to_axis
 from eyestereo.tools.models import cornerness as corner_model
+from eyestereo.tools.models.census import census_bits
 from eyestereo.tools.models import harris_window as window_model
 from eyestereo.tools.models import nms as nms_model
 from eyestereo.tools.models import sobel as sobel_model
@@ -355,6 +357,10 @@ BLOCKS: dict[str, BlockSpec] = {b.name: b for b in (
     block("nms", "separable non-maximum suppression 1x1/3x3/5x5 with a raster tie rule, 1-bit flags", nms,
           port_params=dict(stereo=False), sink_width=_fixed(corner_model.WORD.width),
           source_width=_fixed(nms_model.WORD.width)),
+    # dense stereo (issue 28): both cameras of a stereo stream, as the rectifier delivers them
+    block("census", "census transform 5x5 / 7x7 of both cameras, out-of-image neighbours 0, 24 / 48-bit words",
+          census, port_params=dict(stereo=True), sink_width=_fixed(8),
+          source_width=lambda p: census_bits(p["window"])),
     block("poly_unit", "the four rectification polynomials, 8-stage pipeline, 9 multipliers, 1 coordinate/clock",
           poly_unit, differ=POLY_DEFAULTS, build=_build_poly_unit),  # POLY_DEFAULTS says why
     block("coordinate_warper", "x/y counters, poly_unit and the double-buffered coordinate pair output (4 clocks/pair)",

@@ -25,7 +25,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-__all__ = ["pack_dsp_registers", "pack_file"]
+__all__ = ["ff_kind", "net_maps", "pack_dsp_registers", "pack_file"]
 
 DSP = "MULT18X18D"
 FF = "TRELLIS_FF"
@@ -36,8 +36,9 @@ def _is_const(bit) -> bool:
     return isinstance(bit, str)
 
 
-def _ff_kind(cell: dict) -> tuple | None:
-    """(clock net, enable net or '1') of a plain flip-flop: rising edge, no reset; else None."""
+def ff_kind(cell: dict) -> tuple | None:
+    """(clock net, enable net, '1' or ('INV', net)) of a plain flip-flop: rising edge, no reset, no initial
+    value; else None."""
     p, c = cell["parameters"], cell["connections"]
     if p.get("CLKMUX", "CLK").strip() != "CLK" or c.get("LSR", ["0"]) != ["0"]:
         return None
@@ -55,15 +56,12 @@ def _ff_kind(cell: dict) -> tuple | None:
     return c["CLK"][0], en
 
 
-def pack_dsp_registers(netlist: dict, top: str) -> dict:
-    """Pack flip-flops into the MULT18X18Ds of module ``top`` in place; returns counts
-    (``dsps``, ``input_regs``, ``output_regs``: multipliers given input / output registers,
-    ``ffs_removed``)."""
-    mod = netlist["modules"][top]
-    cells = mod["cells"]
+def net_maps(mod: dict) -> tuple[dict, dict]:
+    """(drivers, loads) of a Yosys JSON module: net -> (cell, port), net -> [(cell, port, bit index)];
+    the module's ports appear as cell ``$port``."""
     drivers: dict = {}
     loads: dict = {}
-    for name, cell in cells.items():
+    for name, cell in mod["cells"].items():
         dirs = cell.get("port_directions", {})
         for port, bits in cell["connections"].items():
             for i, b in enumerate(bits):
@@ -81,6 +79,16 @@ def pack_dsp_registers(netlist: dict, top: str) -> dict:
                 loads.setdefault(b, []).append(("$port", pname, 0))
             if port["direction"] != "output":
                 drivers[b] = ("$port", pname)
+    return drivers, loads
+
+
+def pack_dsp_registers(netlist: dict, top: str) -> dict:
+    """Pack flip-flops into the MULT18X18Ds of module ``top`` in place; returns counts
+    (``dsps``, ``input_regs``, ``output_regs``: multipliers given input / output registers,
+    ``ffs_removed``)."""
+    mod = netlist["modules"][top]
+    cells = mod["cells"]
+    drivers, loads = net_maps(mod)
     stats = dict(dsps=0, input_regs=0, output_regs=0, ffs_removed=0, inverters=0)
     removed: set = set()
     nets = [b for c in cells.values() for bits in c["connections"].values() for b in bits if not _is_const(b)]
@@ -112,7 +120,7 @@ def pack_dsp_registers(netlist: dict, top: str) -> dict:
             drv = drivers.get(b)
             if drv is None or drv[0] == "$port" or drv[0] in removed or cells[drv[0]]["type"] != FF or drv[1] != "Q":
                 return None
-            kind = _ff_kind(cells[drv[0]])
+            kind = ff_kind(cells[drv[0]])
             if kind is None or (clk is not None and kind != (clk, en)):
                 return None
             clk, en = kind
@@ -146,7 +154,7 @@ def pack_dsp_registers(netlist: dict, top: str) -> dict:
             if len(ls) != 1 or ls[0][0] == "$port" or cells[ls[0][0]]["type"] != FF or ls[0][1] != "DI":
                 outs = None
                 break
-            kind = _ff_kind(cells[ls[0][0]])
+            kind = ff_kind(cells[ls[0][0]])
             if kind is None or (oclk is not None and kind != oclk):
                 outs = None
                 break
@@ -238,10 +246,11 @@ def pack_dsp_registers(netlist: dict, top: str) -> dict:
     return stats
 
 
-def pack_file(path: str | Path, top: str) -> dict:
-    """:func:`pack_dsp_registers` on a Yosys JSON file, rewritten in place."""
+def pack_file(path: str | Path, top: str, pack=pack_dsp_registers) -> dict:
+    """A netlist pass (``pack``: :func:`pack_dsp_registers` or another with its signature) on a Yosys JSON
+    file, rewritten in place; returns the pass's counts."""
     path = Path(path)
     netlist = json.loads(path.read_text())
-    stats = pack_dsp_registers(netlist, top)
+    stats = pack(netlist, top)
     path.write_text(json.dumps(netlist))
     return stats

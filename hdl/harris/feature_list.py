@@ -142,11 +142,11 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
     # Counters: LUT-RAM of 2 banks x 2^ab entries, address (bank, block, cam); a "fresh" flag per entry
     # says it was written in its bank's frame (a cleared flag reads as 0), so a bank is cleared in one
     # clock. The flags are kept as the counting bank's and the published bank's (they move over when the
-    # banks swap). The counter of the beat due next and its flag are read a clock ahead (its block from
-    # the block position's ``ahead``, its camera the one after the last beat's: left after a right beat or
-    # a token) into registers; the increment starts from them. On the stereo protocol no beat's counter is
-    # the one its predecessor (the clock before) writes; a beat that breaks the left-right order (two of
-    # one camera in turn) is counted from the other camera's counter.
+    # banks swap). The counters of the block due next (both cameras') and their flags are read a clock ahead
+    # (the block from the block position's ``ahead``) into registers, and the camera due (the one after the
+    # last beat's: left after a right beat or a token) picks one; the increment starts from it. On the stereo
+    # protocol no beat's counter is the one its predecessor (the clock before) writes; a beat that breaks the
+    # left-right order (two of one camera in turn) is counted from the other camera's counter.
     nent = 1 << ab
     cmem = [Signal(intbv(0)[cb:]) for _ in range(2 * nent)]
     fcnt = Signal(intbv(0)[nent:])  # the counting bank's flags
@@ -159,11 +159,13 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
     rfresh = Signal(bool(0))
     due = Signal(bool(0))  # the camera of the beat due now
     due_next = Signal(bool(0))
-    aidx = Signal(intbv(0)[ab:])  # (block, cam) of the beat due next
-    aaddr = Signal(intbv(0)[ab + 1:])
-    afresh = Signal(bool(0))
-    aread = Signal(intbv(0)[cb:])  # the counter of the beat due, registered, and its flag
-    afresh_q = Signal(bool(0))
+    # both cameras' counters of the block due next, and their flags, registered; the camera due picks one after
+    # the registers (issue 26: picking it before the read made the beat's camera -> LUT-RAM address -> register
+    # the memory clock's slowest path of the single-clock front end)
+    aidx_l, aidx_r = Signal(intbv(0)[ab:]), Signal(intbv(0)[ab:])
+    aaddr_l, aaddr_r = Signal(intbv(0)[ab + 1:]), Signal(intbv(0)[ab + 1:])
+    aread_l, aread_r = Signal(intbv(0)[cb:]), Signal(intbv(0)[cb:])
+    afresh_l, afresh_r = Signal(bool(0)), Signal(bool(0))
     cur = Signal(intbv(0)[cb:])
     tot0 = Signal(intbv(0)[cb:])
     tot1 = Signal(intbv(0)[cb:])
@@ -183,9 +185,10 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
             due_next.next = not sink.cam and not (sink.eof and not sink.eol)
         else:
             due_next.next = due
-        aidx.next = concat(ahead, due_next)
-        aaddr.next = concat(bank, ahead, due_next)
-        afresh.next = fcnt[aidx]
+        aidx_l.next = concat(ahead, False)
+        aidx_r.next = concat(ahead, True)
+        aaddr_l.next = concat(bank, ahead, False)
+        aaddr_r.next = concat(bank, ahead, True)
         rfresh.next = fpub[count_addr]
 
     @always_comb
@@ -194,17 +197,24 @@ def feature_list(clk, rst, sink, source, count_addr, count_data, total_left, tot
             count_data.next = cmem[raddr]
         else:
             count_data.next = 0
-        if afresh_q:
-            cur.next = aread
+        if due:
+            if afresh_r:
+                cur.next = aread_r
+            else:
+                cur.next = 0
+        elif afresh_l:
+            cur.next = aread_l
         else:
             cur.next = 0
 
     @always_seq(clk.posedge, reset=rst)
     def cahead():
         due.next = due_next
-        aread.next = cmem[aaddr]
+        aread_l.next = cmem[aaddr_l]
+        aread_r.next = cmem[aaddr_r]
         # a list's end clears the bank that counts next (token: this one; last: the other)
-        afresh_q.next = afresh and not (token or last)
+        afresh_l.next = fcnt[aidx_l] and not (token or last)
+        afresh_r.next = fcnt[aidx_r] and not (token or last)
 
     @always(clk.posedge)
     def cwrite():

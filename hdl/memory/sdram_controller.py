@@ -198,7 +198,7 @@ def sdram_controller(clk, rst, port, pins, *, part: str = ULX3S, clock_mhz: floa
     Resources: the pin registers (about 40 flip-flops, for the I/O blocks), per bank an open flag, a row
     register, two timers and three timer flags, two burst registers (current and next) with two bank
     flags each, the refresh counter and the read-flag pipeline. Measured (docs/memory.md, AS4C32M16SB-7,
-    max_burst 8): 100 MHz CL 2: 572 LUT / 255 FF (Spartan-3E), 573 LUT4 / 255 FF (ECP5), ECP5-85 fmax 119.9 /
+    max_burst 8): 100 MHz CL 2: 572 LUT / 255 FF (Spartan-3E), 573 LUT4 / 255 FF (ECP5), LFE5U-25F fmax 119.9 /
     125.8 / 126.2 MHz (min / median / max over nextpnr seeds 1-4; before the registered flags 695 LUT4 / 252
     FF and 88.0 MHz); 133 MHz CL 3: 683 LUT4 / 261 FF, 122.4 / 130.6 / 132.8 MHz (under its own clock: its
     worst paths, the decision into the bank timers and the pin registers, are 6-8 LUTs with 6 ns of

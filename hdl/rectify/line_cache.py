@@ -16,10 +16,15 @@ __all__ = ["BANK", "FIRST_BEAT", "line_cache"]
 BANK = 2048
 BANK_BITS = BANK.bit_length() - 1
 
+#: Banks per first-stage select: the response picks a bank in two registered steps, one of GROUP banks, then
+#: one of the groups and the camera (a 40:1 select from block RAMs spread over the chip missed 110 MHz at VGA).
+GROUP = 4
+
 #: Clocks from a request moving (``req_valid`` and ``req_ready`` at an edge) to its first beat on the
 #: response, its rows being in: the request register, the beat expander, the block RAMs, each one's output register
-#: (a block RAM's clock-to-output takes most of a clock: issue 26), the response register (the bank's select).
-FIRST_BEAT = 6
+#: (a block RAM's clock-to-output takes most of a clock: issue 26), the group select, the response register (the
+#: group's and camera's select).
+FIRST_BEAT = 7
 
 
 @block
@@ -46,14 +51,14 @@ def line_cache(clk, rst, cam0, cam1, fetch, start, run, arm, begun, overrun, *, 
     The first word after ``rst`` or after a frame's end (``eof``, or a reset token) is pixel (0, 0).
 
     Timing of two requests whose rows are in (``#`` high, ``_`` low, ``.`` don't care; a request moves at the
-    rising edge that ends a cycle with ``req_valid`` and ``req_ready`` high; :data:`FIRST_BEAT` = 5)::
+    rising edge that ends a cycle with ``req_valid`` and ``req_ready`` high; :data:`FIRST_BEAT` = 7)::
 
-        cycle      0    1    2    3    4    5    6    7    8    9   10   11
-        req_valid  #    _    #    #    _    _    _    _    _    _    _    _
-        req_ready  #    _    #    _    #    #    #    #    #    #    #    #
-        req_mask   1111 .    0101 .    .    .    .    .    .    .    .    .
-        rsp_valid  _    _    _    _    _    _    #    #    #    #    #    #
-        rsp_idx    .    .    .    .    .    .    0    1    2    3    0    2
+        cycle      0    1    2    3    4    5    6    7    8    9   10   11   12
+        req_valid  #    _    #    #    _    _    _    _    _    _    _    _    _
+        req_ready  #    _    #    _    #    #    #    #    #    #    #    #    #
+        req_mask   1111 .    0101 .    .    .    .    .    .    .    .    .    .
+        rsp_valid  _    _    _    _    _    _    _    #    #    #    #    #    #
+        rsp_idx    .    .    .    .    .    .    .    0    1    2    3    0    2
 
     A request is taken every other clock at most (``req_ready`` is low in the clock after one moves); the
     beats of consecutive requests follow each other without a gap.
@@ -75,12 +80,12 @@ def line_cache(clk, rst, cam0, cam1, fetch, start, run, arm, begun, overrun, *, 
         lines: L, the lines kept per camera, a power of two 2..64 (default 32: the synthetic rig's and the OpenCV
             calibration's at CIF; :func:`eyestereo.tools.models.line_cache.plan`).
 
-    Latency: a fetch of rows already in: :data:`FIRST_BEAT` = 6 clocks to its first pixel, then one pixel per
-    clock. A fetch waiting for its rows: 6 clocks after the camera word that completes the lower row.
+    Latency: a fetch of rows already in: :data:`FIRST_BEAT` = 7 clocks to its first pixel, then one pixel per
+    clock. A fetch waiting for its rows: 7 clocks after the camera word that completes the lower row.
 
     Resources: per camera ``ceil(lines * width / 2048)`` block RAMs of 2048 bytes (one write and one read port
-    each; 6 at 352 x 32 lines, 20 at 640 x 64), their output registers and the bank select, a ROM of the ``lines``
-    slot addresses, two row counters, a request register and the beat expander (docs/memory.md).
+    each; 6 at 352 x 32 lines, 20 at 640 x 64), their output registers and the two-step bank select, a ROM
+    of the ``lines`` slot addresses, two row counters, a request register and the beat expander (docs/memory.md).
     """
     check_clock(clk)
     check_reset(rst)
@@ -119,10 +124,17 @@ def line_cache(clk, rst, cam0, cam1, fetch, start, run, arm, begun, overrun, *, 
     raddr = Signal(intbv(0, min=0, max=depth))
     # each bank's word, registered straight after its block RAM: the bank select comes a clock later (issue 26:
     # a ring of several block RAMs read through their select into one register missed 110 MHz)
-    q0 = [Signal(intbv(0)[8:]) for _ in range(nbanks)]
-    q1 = [Signal(intbv(0)[8:]) for _ in range(nbanks)]
+    # by groups of GROUP banks (each group's list is the memory its select reads; a signal lives in one list)
+    ngroups = -(-nbanks // GROUP)
+    sizes = [min(GROUP, nbanks - g * GROUP) for g in range(ngroups)]
+    q0 = [[Signal(intbv(0)[8:]) for _ in range(n)] for n in sizes]
+    q1 = [[Signal(intbv(0)[8:]) for _ in range(n)] for n in sizes]
     r_lo = Signal(intbv(0)[BANK_BITS:])
-    r_hi, d_hi, o_hi = (Signal(intbv(0, min=0, max=nbanks)) for _ in range(3))
+    r_hi, d_hi = (Signal(intbv(0, min=0, max=nbanks)) for _ in range(2))
+    o_lo = Signal(intbv(0)[2:])  # the bank within its group (GROUP = 4)
+    o_grp, p_grp = (Signal(intbv(0, min=0, max=max(2, ngroups))) for _ in range(2))
+    p0 = [Signal(intbv(0)[8:]) for _ in range(ngroups)]  # each group's word, both cameras
+    p1 = [Signal(intbv(0)[8:]) for _ in range(ngroups)]
 
     @block
     def bank(we, waddr, wdata, q, *, index):
@@ -213,7 +225,34 @@ def line_cache(clk, rst, cam0, cam1, fetch, start, run, arm, begun, overrun, *, 
         return decode, luma, banks, count
 
     for c, port in enumerate((cam0, cam1)):
-        insts.append(writer(port, (q0, q1)[c], rows[c], lapped[c], fresh[c], lap_event[c]))
+        # a tuple: the writer hands each bank its own word (not a memory of the writer's)
+        flat = tuple(q for grp in (q0, q1)[c] for q in grp)
+        insts.append(writer(port, flat, rows[c], lapped[c], fresh[c], lap_event[c]))
+
+    @block
+    def group_select(qa, qb, pa, pb):
+        """One group's word of each camera, registered: the first step of the bank select."""
+        n = len(qa)
+        if n == 1:
+            @always(clk.posedge)
+            def select():
+                pa.next = qa[0]
+                pb.next = qb[0]
+        elif n == GROUP:
+            @always(clk.posedge)
+            def select():
+                pa.next = qa[o_lo]
+                pb.next = qb[o_lo]
+        else:  # the last group, short: o_lo never points past it when it is the one selected
+            @always(clk.posedge)
+            def select():
+                if o_lo < n:
+                    pa.next = qa[o_lo]
+                    pb.next = qb[o_lo]
+
+        return select
+
+    insts += [group_select(q0[g], q1[g], p0[g], p1[g]) for g in range(ngroups)]
 
     # ---- requests: one register, then the beat expander -------------------------------------------------
     q_valid = Signal(bool(0))
@@ -236,6 +275,8 @@ def line_cache(clk, rst, cam0, cam1, fetch, start, run, arm, begun, overrun, *, 
     d_idx = Signal(intbv(0)[2:])
     o_valid, o_cam = Signal(bool(0)), Signal(bool(0))
     o_idx = Signal(intbv(0)[2:])
+    p_valid, p_cam = Signal(bool(0)), Signal(bool(0))
+    p_idx = Signal(intbv(0)[2:])
     e_last = Signal(bool(0))
     pick = Signal(intbv(0)[2:])
     q_rows = Signal(intbv(0, min=0, max=height + 1))
@@ -306,6 +347,7 @@ def line_cache(clk, rst, cam0, cam1, fetch, start, run, arm, begun, overrun, *, 
         r_valid.next = e_mask != 0
         d_valid.next = r_valid
         o_valid.next = d_valid
+        p_valid.next = o_valid
         overrun.next = (go and late) or lap_event[0] or lap_event[1]
 
     @always(clk.posedge)
@@ -332,7 +374,7 @@ def line_cache(clk, rst, cam0, cam1, fetch, start, run, arm, begun, overrun, *, 
 
     @always_seq(clk.posedge, reset=rst)
     def response_valid():
-        fetch.rsp_valid.next = o_valid
+        fetch.rsp_valid.next = p_valid
         begun.next = fresh[0] and fresh[1] and not start and not arm
 
     @always(clk.posedge)
@@ -342,12 +384,16 @@ def line_cache(clk, rst, cam0, cam1, fetch, start, run, arm, begun, overrun, *, 
         o_idx.next = d_idx
         o_cam.next = d_cam
         d_hi.next = r_hi
-        o_hi.next = d_hi
-        fetch.rsp_idx.next = o_idx
-        if o_cam:
-            fetch.rsp_data.next = q1[o_hi]
+        o_lo.next = d_hi % GROUP
+        o_grp.next = d_hi // GROUP
+        p_idx.next = o_idx
+        p_cam.next = o_cam
+        p_grp.next = o_grp
+        fetch.rsp_idx.next = p_idx
+        if p_cam:
+            fetch.rsp_data.next = p1[p_grp]
         else:
-            fetch.rsp_data.next = q0[o_hi]
+            fetch.rsp_data.next = p0[p_grp]
 
     @always_comb
     def read_address():

@@ -15,7 +15,7 @@ the power-up sequence (the model checks every rule and the scoreboard every read
 
 Words per clock count every word the port moved in the window (read words returned, write words taken);
 MB/s is that times 2 bytes times the clock. ``--synth`` adds the controller's resources (Yosys: Spartan-3E
-and ECP5) and fmax on the ECP5-85 over nextpnr seeds 1-4. The tables go into the ``bench_sdram`` section of
+and ECP5) and fmax on the ECP5 (LFE5U-25F) over nextpnr seeds 1-4. The tables go into the ``bench_sdram`` section of
 the page given by ``--out``.
 """
 
@@ -84,7 +84,7 @@ def report(rows: list[dict], syn: list[dict] | None, clocks: int) -> str:
               f"with max_burst {p.columns} (a whole row) for every pattern; the other patterns ask for 8 or 1.", ""]
     if syn:
         lines += markdown_table(
-            ["configuration", "Spartan-3E LUT / FF", "ECP5 LUT4 / FF", "ECP5-85 fmax min / median / max (seeds 1-4)"],
+            ["configuration", "Spartan-3E LUT / FF", "ECP5 LUT4 / FF", "ECP5 LFE5U-25F fmax min / median / max (seeds 1-4)"],
             [[f"{s['mhz']:.0f} MHz, CL {s['cl']}, max_burst 8", f"{s['xc3se'].get('LUT', 0)} / {s['xc3se'].get('FF', 0)}",
               f"{s['ecp5'].get('TRELLIS_COMB', 0)} / {s['ecp5'].get('TRELLIS_FF', 0)}",
               f"{s['fmax']['min']:.1f} / {s['fmax']['median']:.1f} / {s['fmax']['max']:.1f} MHz"] for s in syn])

@@ -711,8 +711,10 @@ def main_options(args) -> int:
     vga = (w, h) == (VGA_TIMING.width, VGA_TIMING.height)
     timing = (dict(h_blank=VGA_TIMING.h_blank, v_sync=VGA_TIMING.v_sync, v_back=VGA_TIMING.v_back,
                    v_front=VGA_TIMING.v_front) if vga else timing_of(args.size))
-    # VGA cameras at 24 MHz (the OV7670's PCLK), slightly apart as two oscillators are; CIF at the bench's 18/17.9
-    cams = dict(cam_l_mhz=24.0, cam_r_mhz=23.9) if vga else {}
+    # VGA: the OV7670's 30 frames/s need its 24 MHz PCLK; the cameras slightly apart as two oscillators are, the
+    # slower at that figure (as CIF's 18 / 17.9 MHz are both above the OV6630's 17.73 MHz for 50 frames/s)
+    cams = dict(cam_l_mhz=24.1, cam_r_mhz=24.0) if vga else {}
+    cam_mhz = (cams["cam_l_mhz"], cams["cam_r_mhz"]) if vga else (18.0, 17.9)
     try:
         reps = {m: run_mode(m, args.size, n, timing, sim, args.reuse, options=options, **cams)
                 for m, n in (("sequential", args.frames), ("overlapped", args.frames_ovl))}
@@ -727,13 +729,16 @@ def main_options(args) -> int:
     total = sum(moved.values()) or 1
     section = [title, "",
                f"`stereo_frontend(memory=\"{args.memory}\", rectify=\"{args.rectify}\")`, rig calibration at "
-               f"{args.size}, cameras {'24 / 23.9' if vga else '18 / 17.9'} MHz, {sim_label(sim)}; every frame read back "
+               f"{args.size}, cameras {cam_mhz[0]:g} / {cam_mhz[1]:g} MHz, {sim_label(sim)}; every frame read back "
                "by the host over AXI4-Lite bit for bit against the numpy chain"
                + (", the SDRAM model checking every rule of the part (none broken, no refresh late)"
                   if args.memory == "sdram" else "") + ":", "", *_mode_rows(figs), "",
                "Words moved per master in the overlapped run (share of the memory's traffic): " + ", ".join(
                    f"{k} {v} ({100 * v / total:.1f} %)" for k, v in moved.items()) + "; "
-               f"clocks of the run: {arb.get('clocks', '?')}.", ""]
+               f"clocks of the run: {arb.get('clocks', '?')}.", "",
+               f"The cameras' own rate: {min(cam_mhz) * 1e6 / cam.frame_pclk:.2f} frames/s (the slower camera, "
+               f"{cam.frame_pclk} PCLK a frame at {min(cam_mhz):g} MHz): the overlapped mode keeps their pace when its "
+               "frame period is the slower camera's.", ""]
     if args.memory == "sdram":
         sd = {m: r.get("sdram") or {} for m, r in reps.items()}
         section += ["SDRAM refreshes: " + ", ".join(f"{m} {v.get('refreshes', '?')} (late "

@@ -91,7 +91,7 @@ def report(plans: list, runs: list, syn: list, sim: str) -> str:
                             r["overruns"], f"{r['first_beat_lines'][0]:.1f}", f"{r['end_after_last_line'][0]:.1f}",
                             f"{r['sim_seconds']:.0f}"] for r in runs])
     if syn:
-        out += ["", "### Resources and fmax (make synth, ECP5-85 speed 6, seeds 1-4; Spartan-3E counts by Yosys)", ""]
+        out += ["", "### Resources and fmax (make synth, ECP5 LFE5U-25F speed 6, seeds 1-4; Spartan-3E counts by Yosys)", ""]
         out += markdown_table(["configuration", "XC3S LUT", "RAMB16", "MULT18X18", "ECP5 cells: LUT4 / FF / DP16KD / MULT18X18D",
                                "fmax clk (min / median / max, MHz)"], syn)
     return "\n".join(out) + "\n\n"

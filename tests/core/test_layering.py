@@ -43,9 +43,10 @@ FORBIDDEN = {
 # The table
 
 #: Every part of tools (``core`` = its top-level modules): any room of hdl and sim may import them.
-TOOLS = {"tools/core", "tools/models", "tools/rectify", "tools/matching", "tools/cli", "tools/reports"}
+TOOLS = {"tools/core", "tools/models", "tools/rectify", "tools/matching", "tools/dense", "tools/cli", "tools/reports"}
 #: The rooms of hdl that hold blocks (and the port bundles and helpers they are made of).
-BLOCKS = {f"hdl/{r}" for r in ("interfaces", "common", "streaming", "harris", "rectify", "camera", "memory", "axi")}
+BLOCKS = {f"hdl/{r}" for r in ("interfaces", "common", "streaming", "harris", "rectify", "camera", "memory", "axi",
+                                 "dense")}
 #: All of hdl: the block rooms, the top, the EDA flow and the package itself (``eyestereo.hdl``, which
 #: re-exports the blocks).
 HDL = BLOCKS | {"hdl/system", "hdl/flow", "hdl"}
@@ -58,6 +59,8 @@ ROOMS = {
     "tools/rectify": {"tools/core"},
     "tools/models": {"tools/core", "tools/rectify"},
     "tools/matching": {"tools/core", "tools/models"},
+    # dense stereo's reference, data sets and accuracy page stand on the models (census, sgm, dense_stereo)
+    "tools/dense": {"tools/core", "tools/models"},
     "tools/cli": {"tools/core", "tools/models", "tools/rectify", "tools/matching"},
     "tools/reports": {"tools/core", "tools/models", "tools/rectify", "tools/matching", "tools/cli"},
     # hdl: every room may import tools; no block room imports system or flow
@@ -69,6 +72,8 @@ ROOMS = {
     "hdl/camera": TOOLS | {"hdl/common", "hdl/interfaces", "hdl/streaming"},
     "hdl/memory": TOOLS | {"hdl/common", "hdl/interfaces"},
     "hdl/axi": TOOLS | {"hdl/common", "hdl/interfaces"},
+    # dense stereo (issue 28): census (and the matching blocks to come) on the library's window machinery
+    "hdl/dense": TOOLS | {"hdl/common", "hdl/interfaces", "hdl/streaming"},
     "hdl/system": TOOLS | BLOCKS,
     "hdl/flow": TOOLS | BLOCKS | {"hdl/system"},
     "hdl": TOOLS | BLOCKS | {"hdl/system"},
@@ -85,10 +90,11 @@ ROOMS = {
 #: The rooms from the bottom up: a room imports only rooms of lower tiers, except that the two rooms of
 #: :data:`BASE` import each other (the port bundles use the checks, the checks know the bundles).
 TIERS = [
-    {"tools/core"}, {"tools/rectify"}, {"tools/models"}, {"tools/matching"}, {"tools/cli"}, {"tools/reports"},
+    {"tools/core"}, {"tools/rectify"}, {"tools/models"}, {"tools/matching", "tools/dense"}, {"tools/cli"},
+    {"tools/reports"},
     {"hdl/interfaces", "hdl/common"},
     {"hdl/streaming"},
-    {"hdl/harris", "hdl/rectify", "hdl/camera", "hdl/memory", "hdl/axi"},
+    {"hdl/harris", "hdl/rectify", "hdl/camera", "hdl/memory", "hdl/axi", "hdl/dense"},
     {"hdl/system"},
     {"hdl/flow", "hdl"},
     {"sim", "sim/lib", "sim/harnesses"},

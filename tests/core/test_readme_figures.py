@@ -33,7 +33,8 @@ def readme_rows() -> dict[str, str]:
     for line in text.splitlines():
         m = re.match(r"^\| `(\w+)` \|", line)
         if m:
-            cells = [c.strip() for c in line.strip().strip("|").split("|")]
+            # a cell may hold an escaped pipe (a backslash before it): split on the others only
+            cells = [c.strip() for c in re.split(r"(?<!\\)\|", line.strip().strip("|"))]
             if len(cells) == 4:
                 out[m.group(1)] = cells[3]
     return out

@@ -79,6 +79,23 @@ def test_stereo_frontend_stream(request, mode, memory):
     assert arb["moved_rect"] >= 3 * W * H and arb["moved_feat"] > 0
 
 
+@pytest.mark.sim
+def test_stereo_frontend_sdram_fetch(request):
+    """memory="sdram" with the thesis's rectify="fetch": the camera frames in the SDRAM and the rectifier's 2x2
+    fetches from there (rows apart: the SDRAM's worst access pattern, but the same results); every option of the
+    top keeps the register map, the host driver and the numpy chain."""
+    rep = run_bench("stereo_frontend", "tb_stereo_frontend",
+                    dict(mode="sequential", frames=2, images="shift:3", timing=TIMING, require_features=True, pause=0.0,
+                         adaptive=None),
+                    name=request.node.name, params=dict(quantizers=SPEC, feature_words=256, max_features=127,
+                                                        memory="sdram", sdram_part="AS4C32M16SB-7:powerup_us=1"))
+    assert rep["bit_exact"] and len(rep["frames"]) == 2
+    assert rep["sdram"]["refreshes"] > 20 and rep["sdram"]["late_refreshes"] == 0
+    arb = rep["arb"]
+    assert arb["moved_cam0"] >= 2 * W * H and arb["moved_fetch"] > W * H  # the camera frames, fetched back
+    assert arb["moved_rect"] >= 2 * W * H and arb["moved_feat"] > 0
+
+
 def test_model_is_the_chain():
     """The system model is the composition of the block models (spot check on one frame)."""
     from eyestereo.hdl.rectify.calibration import calibration_param
