@@ -109,6 +109,7 @@ VARIANTS = [
     ("stream_rectifier rig:640x480", "stream_rectifier", dict(quantizers="rig:640x480")),
     ("stereo_frontend stream", "stereo_frontend", dict(rectify="stream")),
     ("stereo_frontend sdram stream", "stereo_frontend", dict(memory="sdram", rectify="stream")),
+    ("census 7x7", "census", dict(window=7)),
 ]
 #: Clock ports a variant leaves unused (no goal row for them): the single-clock front end has no Harris clock.
 UNUSED_CLOCKS = {"stereo_frontend single-clock": ("hclk",)}
