@@ -1,12 +1,12 @@
 """Census transform of a 5x5 or 7x7 window, both cameras of a stereo stream, borders defined (issue 28)."""
 
-from myhdl import ConcatSignal, Signal, always, always_comb, always_seq, block, intbv
+from myhdl import ConcatSignal, Signal, always, always_comb, block, intbv
 
-from eyestereo.hdl.common import delay, en_reg
+from eyestereo.hdl.common import en_reg
 from eyestereo.hdl.common.checks import (block_error, check_choice, check_clock, check_distinct, check_frame,
                                          check_reset, check_stream)
-from eyestereo.hdl.common.registers import delay_rst
 from eyestereo.hdl.interfaces.stream import ImageStream
+from eyestereo.hdl.streaming.flush_control import flush_control
 from eyestereo.hdl.streaming.window import column_taps, tap_latency, window_row
 from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 from eyestereo.tools.models.census import WINDOWS, census_bits
@@ -35,12 +35,9 @@ def census(clk, rst, sink, source, *, window: int = 5, width: int = FRAME_WIDTH,
     Bottom rows: the output runs r lines + r pixels behind the input, so the last r lines of a frame
     are computed after the frame's last beat. Their windows still need the image's last lines, which
     sit in the line delays: the block pushes its own flush beats through the line delays (in clocks
-    the sink leaves free) until the frame's tail is out. The line delays' column counters never
-    clear (their eof input is held low): a frame may begin at any column, as long as all its lines
-    begin at the same one, so the flush beats need not be aligned to a line. When the next frame
-    arrives before the tail is out, its beats stand in for the flush beats (their own windows are
-    not output: they belong to the new frame's top rows, still being filled), and no flush beat is
-    put between two beats of the new frame (that would shift its lines against each other).
+    the sink leaves free, or the next frame's beats standing in for them) until the frame's tail is
+    out (:func:`~eyestereo.hdl.streaming.flush_control.flush_control`, which also counts the output
+    raster and gives the border flags; median3 shares it).
 
     Ports:
         clk, rst: clock and synchronous active-high reset (control only; the line delays and the
@@ -87,128 +84,14 @@ def census(clk, rst, sink, source, *, window: int = 5, width: int = FRAME_WIDTH,
                           f"height must each be at least {window}")
     stereo = sink.stereo
     n, r = window, window // 2
-    # pixels (of each camera) the output runs behind the input; counted in beats on a stereo stream
-    lead = (r * width + r) * (2 if stereo else 1)
 
-    # --- input register: one clock of look-ahead, so that a stereo flush pair (left, right) is only
-    # started in a clock whose next clock is free of sink beats too
-    d1 = Signal(intbv(0)[8:])
-    v1, l1, f1, c1 = (Signal(bool(0)) for _ in range(4))
-    insts = [delay(clk, sink.data, d1, clocks=1), delay_rst(clk, rst, sink.valid, v1, clocks=1),
-             delay_rst(clk, rst, sink.eol, l1, clocks=1), delay_rst(clk, rst, sink.eof, f1, clocks=1)]
-    if stereo:
-        insts.append(delay_rst(clk, rst, sink.cam, c1, clocks=1))
-
-    # --- the beats that move the line delays: the sink's pixels and the block's own flush beats
+    # --- control: the beats into the line delays (the sink's and the flush beats), the output raster and
+    # its flags, the border flags of the emitted pixel in the clock the window rows hold its window
     shift = ImageStream(8, stereo=stereo)
-    skip = Signal(intbv(lead, min=0, max=lead + 1))  # beats of the frame still before its first output
-    tail = Signal(intbv(0, min=0, max=lead + 1))  # outputs of the last frame still to come
-    fcam = Signal(bool(0))  # camera of the next flush beat (stereo)
-    pix, token, flush, emit, ecam = (Signal(bool(0)) for _ in range(5))
-
-    @always_comb
-    def beats():
-        pix.next = v1 and (l1 or not f1)
-        token.next = v1 and f1 and not l1
-        # a flush beat: the tail is not out, the clock is free, and the next frame has not begun
-        # (skip == lead until its first pixel); a stereo left flush beat also needs the sink free now,
-        # so that its right beat has the next clock (the sink's beat of now waits in the input register)
-        flush.next = False
-        if tail != 0 and not v1 and skip == lead:
-            if not stereo or fcam or not sink.valid:
-                flush.next = True
-
-    @always_comb
-    def merge():
-        shift.data.next = d1  # a flush beat's pixel is never used (masked), so no multiplexer
-        shift.valid.next = pix or flush
-        shift.eol.next = False  # held low: the line delays' column counters never clear
-        shift.eof.next = False
-        # an output pixel: the tail of the last frame, or this frame's pixel once lead beats came
-        emit.next = (pix or flush) and (tail != 0 or (pix and skip == 0))
-
-    insts += [beats, merge]
-    if stereo:
-        @always_comb
-        def camera():
-            # the beat's camera: the sink's, or the flush beat's (left, right in turn)
-            if pix:
-                shift.cam.next = c1
-                ecam.next = c1
-            else:
-                shift.cam.next = fcam
-                ecam.next = fcam
-
-        insts.append(camera)
-
-    # --- control: the output raster, its flags and the border flags, one clock after the beat
-    ox = Signal(intbv(0, min=0, max=width))
-    oy = Signal(intbv(0, min=0, max=height))
-    x_last, y_last = Signal(bool(0)), Signal(bool(0))
-    o_valid, o_eol, o_eof, o_cam = (Signal(bool(0)) for _ in range(4))
-
-    @always_seq(clk.posedge, reset=rst)
-    def counters():
-        if token:
-            # abandon the frame and any tail; the next beat is a new frame's first
-            skip.next = lead
-            tail.next = 0
-            fcam.next = False
-        else:
-            if (pix or flush) and tail != 0:
-                tail.next = tail - 1
-            if pix:
-                if f1 and (c1 or not stereo):
-                    # the frame's last beat: its tail follows, the next frame starts skipping
-                    skip.next = lead
-                    tail.next = lead
-                elif skip != 0:
-                    skip.next = skip - 1
-            if flush and stereo:
-                fcam.next = not fcam
-
-    @always_comb
-    def edges():
-        x_last.next = ox == width - 1
-        y_last.next = oy == height - 1
-
-    @always_seq(clk.posedge, reset=rst)
-    def raster():
-        # the output beat's flags (a token passes on as it came), and the position of the next one:
-        # the right camera's beat moves it on (every beat on a mono stream)
-        o_valid.next = token or emit
-        o_eol.next = emit and x_last
-        o_eof.next = token or (emit and x_last and y_last)
-        o_cam.next = (token and c1) or (emit and ecam)
-        if token:
-            ox.next = 0
-            oy.next = 0
-        elif emit and (ecam or not stereo):
-            if not x_last:
-                ox.next = ox + 1
-            else:
-                ox.next = 0
-                if y_last:
-                    oy.next = 0
-                else:
-                    oy.next = oy + 1
-
-    insts += [counters, edges, raster]
-
-    # Border flags of the emitted pixel: row k of the window (dy = k - r) lies inside the image when
-    # 0 <= y + dy <= height - 1, column k (dx = k - r) when 0 <= x + dx <= width - 1. Registered with
-    # the control, then delayed to the comparison stage; the centre row and column are always inside.
     row_ok = [Signal(bool(1)) for _ in range(n)]
     col_ok = [Signal(bool(1)) for _ in range(n)]
-    for k in range(n):
-        if k != r:
-            insts.append(inside_flag(clk, oy, k - r, height, row_ok[k], clocks=tap_latency(n)))
-            insts.append(inside_flag(clk, ox, k - r, width, col_ok[k], clocks=tap_latency(n)))
-    lat = latency(n)
-    flags = [(o_valid, source.valid), (o_eol, source.eol), (o_eof, source.eof)]
-    flags += [(o_cam, source.cam)] if stereo else []
-    for a, b in flags:
-        insts.append(delay_rst(clk, rst, a, b, clocks=lat - 2))
+    insts = [flush_control(clk, rst, sink, shift, source, row_ok, col_ok, width=width, height=height,
+                           latency=latency(n))]
 
     # --- data path: N taps of one column, then N window rows of N columns
     taps = [Signal(intbv(0)[8:]) for _ in range(n)]
@@ -237,20 +120,6 @@ def census(clk, rst, sink, source, *, window: int = 5, width: int = FRAME_WIDTH,
 
     insts.append(outreg)
     return insts
-
-
-@block
-def inside_flag(clk, pos, offset: int, size: int, ok, *, clocks: int):
-    """``ok`` = (0 <= pos + offset <= size - 1), registered, then ``clocks`` clocks later (read in the
-    clock a pixel is emitted, ``pos`` is that pixel's position)."""
-    lo, hi = max(0, -offset), size - 1 - max(0, offset)
-    now = Signal(bool(0))
-
-    @always(clk.posedge)
-    def flag():
-        now.next = lo <= pos and pos <= hi
-
-    return flag, delay(clk, now, ok, clocks=clocks)
 
 
 @block

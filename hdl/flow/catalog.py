@@ -30,6 +30,9 @@ from eyestereo.hdl.interfaces.axis import AxiStream
 from eyestereo.hdl.axi.axis_to_stream import axis_to_stream
 from eyestereo.hdl.streaming.convolve import convolve
 from eyestereo.hdl.dense.census import census
+from eyestereo.hdl.dense.median3 import median3
+from eyestereo.hdl.dense.sgm import sgm
+from eyestereo.hdl.dense.dense_stereo import dense_stereo
 from eyestereo.hdl.harris.cornerness import cornerness
 from eyestereo.hdl.harris.harris_mono import harris_mono
 from eyestereo.hdl.harris.harris_stereo import harris_stereo
@@ -283,6 +286,22 @@ def _build_poly_unit(p):
                        **_coef_port(p, cal))
 
 
+def _dense_settings():
+    return dict(p1=Signal(intbv(0)[8:]), p2=Signal(intbv(0)[8:]), uniqueness=Signal(intbv(0)[7:]),
+                lr_check=Signal(bool(0)), subpixel=Signal(bool(0)), overrun=Signal(bool(0)))
+
+
+def _build_sgm(p):
+    # a stereo sink of census words, a mono source of 16-bit codes and the run-time settings
+    return fresh_ports(sgm, sink=ImageStream(census_bits(p["window"]), stereo=True), source=ImageStream(16),
+                       **_dense_settings())
+
+
+def _build_dense_stereo(p):
+    # a stereo sink of grey pixels, a mono source of 16-bit codes and the run-time settings
+    return fresh_ports(dense_stereo, sink=ImageStream(8, stereo=True), source=ImageStream(16), **_dense_settings())
+
+
 def _build_coordinate_warper(p):
     cal = calibration(p)
     return fresh_ports(coordinate_warper, start=_bit(p), enable=_bit(p), busy=_bit(p), done=_bit(p),
@@ -361,6 +380,12 @@ BLOCKS: dict[str, BlockSpec] = {b.name: b for b in (
     block("census", "census transform 5x5 / 7x7 of both cameras, out-of-image neighbours 0, 24 / 48-bit words",
           census, port_params=dict(stereo=True), sink_width=_fixed(8),
           source_width=lambda p: census_bits(p["window"])),
+    block("sgm", "semi-global matching of census words: D disparities, PU per clock, 2 / 4 paths, uniqueness, "
+          "left-right check, sub-pixel; 16-bit codes", sgm, build=_build_sgm),
+    block("dense_stereo", "census, sgm and the 3x3 median: a rectified stereo stream in, disparity codes out",
+          dense_stereo, build=_build_dense_stereo),
+    block("median3", "3x3 median of 16-bit disparity codes (0xFFFF = invalid, the largest), border pixels passed "
+          "through", median3, sink_width=_fixed(16), source_width=_fixed(16)),
     block("poly_unit", "the four rectification polynomials, 8-stage pipeline, 9 multipliers, 1 coordinate/clock",
           poly_unit, differ=POLY_DEFAULTS, build=_build_poly_unit),  # POLY_DEFAULTS says why
     block("coordinate_warper", "x/y counters, poly_unit and the double-buffered coordinate pair output (4 clocks/pair)",

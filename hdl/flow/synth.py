@@ -81,7 +81,7 @@ CLOCK_GOALS = {
                           "sram_controller", "sram_arbiter", "line_cache", "stream_rectifier", "sdram_controller",
                           "sdram_bridge", "sdram_subsystem",
                           # dense disparity (issue 28) works on the rectified stream in the memory clock
-                          "census")},
+                          "census", "sgm", "median3", "dense_stereo")},
 }
 #: The thesis's own fmax figures (MHz) where it gives one: ISE's estimate for the mono Harris, "no
 #: matter which kind of non-maximum suppression" (6.2.5).
@@ -110,6 +110,9 @@ VARIANTS = [
     ("stereo_frontend stream", "stereo_frontend", dict(rectify="stream")),
     ("stereo_frontend sdram stream", "stereo_frontend", dict(memory="sdram", rectify="stream")),
     ("census 7x7", "census", dict(window=7)),
+    # Issue 28: the 2-path SGM (one previous-row ring instead of three) and 8 disparities per clock
+    ("sgm 2 paths", "sgm", dict(paths=2)),
+    ("sgm pu=8", "sgm", dict(pu=8)),
 ]
 #: Clock ports a variant leaves unused (no goal row for them): the single-clock front end has no Harris clock.
 UNUSED_CLOCKS = {"stereo_frontend single-clock": ("hclk",)}

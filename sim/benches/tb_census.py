@@ -9,36 +9,19 @@ pixel (x + r, y + r), the tail pixels after their frame's last input beat.
 """
 
 import cocotb
-import cv2
 import numpy as np
 from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, RisingEdge
 
 from eyestereo.hdl.dense.census import latency
+from eyestereo.sim.lib.bench import grey_frame as stimulus
 from eyestereo.sim.lib.bench import load_config, write_report
 from eyestereo.sim.lib.stream import UNKNOWN, BeatMonitor, BeatSource, IdleGenerator
-from eyestereo.tools.io import centre_crop
 from eyestereo.tools.models import census as model
 from eyestereo.tools.models.stream_checker import frame_beats
 from eyestereo.tools.stream import TOKEN, FrameAssembler
 
 PERIOD_NS = 10
-
-
-def stimulus(spec: str, width: int, height: int) -> np.ndarray:
-    """A grey frame: ``random:SEED``, ``flat:V`` (every pixel V: ties give 0 bits) or ``image:PATH``
-    (the centre ``width`` x ``height`` of an image file, converted to grey)."""
-    kind, _, arg = spec.partition(":")
-    if kind == "random":
-        return np.random.default_rng(int(arg)).integers(0, 256, (height, width), dtype=np.int64)
-    if kind == "flat":
-        return np.full((height, width), int(arg), np.int64)
-    if kind == "image":
-        img = cv2.imread(arg, cv2.IMREAD_GRAYSCALE)
-        if img is None:
-            raise FileNotFoundError(f"cannot read stimulus image {arg}")
-        return centre_crop(img, width, height, arg).astype(np.int64)
-    raise ValueError(f"unknown stimulus {spec!r}")
 
 
 class CensusTB:

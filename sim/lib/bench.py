@@ -264,3 +264,19 @@ async def run_configured(dut, tb_class: type[StreamTB]) -> dict:
     report["cpu_seconds"] = time.process_time() - cpu0
     write_report(cfg, report)
     return report
+
+
+def grey_frame(spec: str, width: int, height: int) -> np.ndarray:
+    """A grey frame: ``random:SEED``, ``flat:V`` (every pixel V: ties give 0 bits) or ``image:PATH``
+    (the centre ``width`` x ``height`` of an image file, converted to grey)."""
+    kind, _, arg = spec.partition(":")
+    if kind == "random":
+        return np.random.default_rng(int(arg)).integers(0, 256, (height, width), dtype=np.int64)
+    if kind == "flat":
+        return np.full((height, width), int(arg), np.int64)
+    if kind == "image":
+        img = cv2.imread(arg, cv2.IMREAD_GRAYSCALE)
+        if img is None:
+            raise FileNotFoundError(f"cannot read stimulus image {arg}")
+        return centre_crop(img, width, height, arg).astype(np.int64)
+    raise ValueError(f"unknown stimulus {spec!r}")

@@ -1,15 +1,20 @@
-"""The accuracy tools (tools/dense): measures by hand, the ground truth's occlusion mask, resizing, the
-accuracy CLI (bad input: one line, exit 2; a small run writes its section)."""
+"""The accuracy tools (tools/dense): measures by hand, the ground truth's occlusion mask, the holes' background
+interpolation, resizing, the accuracy CLI (bad input: one line, exit 2; a small run writes its section), the
+pictures (files, layout, colours, sizes, a bad folder refused)."""
 
 from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
 
+import cv2
 import numpy as np
 import pytest
 
-from eyestereo.tools.dense import accuracy, datasets, metrics
+from eyestereo.tools.dense import accuracy, datasets, metrics, pictures
+
+PICTURES = Path(__file__).resolve().parents[2] / "docs" / "img" / "dense"
 
 needs_data = pytest.mark.skipif(not (datasets.data_dir() / "middlebury" / "tsukuba" / "im3.png").is_file(),
                                 reason="Middlebury pairs not in the shared data folder")
@@ -47,6 +52,41 @@ def test_scores_by_hand():
         metrics.visible_mask(-gt)
 
 
+def test_fill_background_by_hand():
+    nan = np.nan
+    row = np.array([[nan, 3.0, nan, nan, 7.0, nan, 5.0, nan]])
+    # ends: the nearest valid value; between 3 and 7: the smaller, 3; between 7 and 5: 5
+    assert metrics.fill_background(row).tolist() == [[3.0, 3.0, 3.0, 3.0, 7.0, 5.0, 5.0, 5.0]]
+    assert np.isnan(row[0, 0])  # the input is left alone
+    grid = np.array([[nan, nan, nan],
+                     [2.0, nan, 4.0],
+                     [nan, nan, nan],
+                     [nan, 6.0, nan],
+                     [nan, nan, nan]])
+    # rows 1 and 3 filled along the row; the empty rows from their columns: row 0 from row 1 (top end),
+    # row 2 the smaller of rows 1 and 3, row 4 from row 3 (bottom end)
+    assert metrics.fill_background(grid).tolist() == [[2.0, 2.0, 4.0], [2.0, 2.0, 4.0], [2.0, 2.0, 4.0],
+                                                      [6.0, 6.0, 6.0], [6.0, 6.0, 6.0]]
+    assert np.isnan(metrics.fill_background(np.full((2, 3), nan))).all()
+    with pytest.raises(ValueError, match="2-D"):
+        metrics.fill_background(np.zeros(4))
+
+
+def test_bad2_interpolated_by_hand():
+    nan = np.nan
+    gt = np.array([[4.0, 4.0, 4.0, 9.0, 9.0, 9.0]] * 2)
+    est = np.array([[4.0, nan, nan, 9.0, nan, 9.0],    # holes in the background: filled right
+                    [nan, 4.0, 4.0, nan, 9.0, 9.0]])   # x = 3 filled with 4 (the farther side), truth 9: bad
+    s = metrics.scores(est, gt, visible=np.ones_like(gt, bool))
+    assert s["bad2_noc"] == 0.0
+    assert s["bad2_filled"] == pytest.approx(100 * 5 / 12)   # the five holes
+    assert s["bad2_interp"] == pytest.approx(100 * 1 / 12)
+    vis = np.ones_like(gt, bool)
+    vis[1, 3] = False  # the one bad filled pixel left out of noc
+    assert metrics.scores(est, gt, visible=vis)["bad2_interp"] == 0.0
+    assert metrics.scores(np.full_like(gt, nan), gt, visible=np.ones_like(gt, bool))["bad2_interp"] == 100.0
+
+
 def test_resize_scales_disparities_with_the_width():
     rng = np.random.default_rng(0)
     img = rng.integers(0, 256, (40, 80), dtype=np.uint8)
@@ -76,6 +116,14 @@ def test_cli_bad_input_one_line(args):
     assert len(r.stderr.strip().splitlines()) == 1 and "error:" in r.stderr
 
 
+def test_cli_pictures_refused_one_line(tmp_path):
+    r = run_cli("--pictures", tmp_path / "pics", "--out", tmp_path / "dense.md")
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "--pictures" in r.stderr
+    (tmp_path / "a_file").write_text("x")
+    r = run_cli("--pictures", tmp_path / "a_file")
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "is a file" in r.stderr
+
+
 def test_cli_page_without_markers(tmp_path):
     page = tmp_path / "dense.md"
     page.write_text("# no section here\n")
@@ -96,3 +144,59 @@ def test_cli_writes_its_section(tmp_path):
     row = next(line for line in text.splitlines() if line.startswith("| tsukuba | 352x288 |"))
     ours, sgbm = (float(c) for c in row.split("|")[3:5])
     assert ours <= sgbm + 2  # the issue's goal on this pair
+
+
+def synthetic_pair() -> datasets.Pair:
+    """A random texture and its copy 5 px to the left; ground truth 5 px, unknown in the first 3 columns."""
+    rng = np.random.default_rng(1)
+    left = cv2.GaussianBlur(rng.integers(0, 256, (64, 96), dtype=np.uint8), (3, 3), 0)
+    right = np.roll(left, -5, axis=1)
+    gt = np.full(left.shape, 5.0)
+    gt[:, :3] = np.nan
+    return datasets.Pair("synthetic", left, right, gt)
+
+
+def test_picture_writer(tmp_path):
+    pair = synthetic_pair()
+    paths = accuracy.write_pictures(tmp_path / "pics", [pair], disparities=16)
+    assert paths == [tmp_path / "pics" / "synthetic.png"]
+    data = paths[0].read_bytes()
+    assert data.startswith(b"\x89PNG") and len(data) < 300_000
+    img = cv2.imread(str(paths[0]))  # BGR
+    h, w = pair.left.shape
+    panels = 5  # left image, ground truth, ours, SGBM, BM
+    assert img.shape == (pictures.LABEL_HEIGHT + h + pictures.GAP + pictures.STRIP_HEIGHT,
+                         pictures.GAP + panels * (w + pictures.GAP), 3)
+    # the ground truth panel: unknown columns black, the rest 5 px = the top of the scale (vmax = 5):
+    # OpenCV's turbo colour of level 255
+    x0, y = pictures.GAP + (w + pictures.GAP), pictures.LABEL_HEIGHT + h // 2
+    top = cv2.applyColorMap(np.array([[255]], np.uint8), cv2.COLORMAP_TURBO)[0, 0]
+    assert img[y, x0:x0 + 3].tolist() == [[0, 0, 0]] * 3
+    assert img[y, x0 + 3:x0 + w].tolist() == [top.tolist()] * (w - 3)
+    # the left image panel is the image in 128 grey levels (within half a step of 255 / 127)
+    left_panel = img[pictures.LABEL_HEIGHT:pictures.LABEL_HEIGHT + h, pictures.GAP:pictures.GAP + w, 1]
+    assert np.abs(left_panel.astype(int) - pair.left).max() <= 1
+    # the same maps give the same bytes
+    assert accuracy.write_pictures(tmp_path / "again", [pair], disparities=16)[0].read_bytes() == data
+
+
+def test_picture_folder_refused_one_line(tmp_path):
+    (tmp_path / "a_file").write_text("x")
+    for bad, why in ((tmp_path / "a_file", "is a file"), (tmp_path / "no" / "such", "neither does its parent")):
+        with pytest.raises(ValueError, match=why) as e:
+            accuracy.write_pictures(bad, [synthetic_pair()], disparities=16)
+        assert "\n" not in str(e.value)
+    assert not (tmp_path / "no").exists()
+
+
+def test_committed_pictures_are_small():
+    files = sorted(PICTURES.glob("*.png"))
+    assert [f.stem for f in files] == sorted(datasets.PAIRS)
+    assert all(f.stat().st_size < 300_000 for f in files)
+
+
+@needs_data
+def test_committed_pictures_are_the_modules(tmp_path):
+    assert accuracy.main(["--pictures", str(tmp_path), "--pairs", "tsukuba"]) == 0
+    made, committed = (cv2.imread(str(p / "tsukuba.png")) for p in (tmp_path, PICTURES))
+    assert made is not None and committed is not None and np.array_equal(made, committed)

@@ -13,13 +13,16 @@ Conventions (the page docs/dense.md repeats them):
   ``|d - d_gt| > t`` (in %); ``density`` = share of the region's pixels with a valid estimate (in %);
   ``rms`` = root mean square error over the region's valid estimates (px); ``bad-2 filled`` counts every
   pixel of the region without an estimate as bad too (in %), so a method cannot gain by leaving holes.
+* ``bad-2 interpolated`` is the benchmarks' way: the holes are filled first by :func:`fill_background`
+  (KITTI's devkit, ``DisparityImage::interpolateBackground``, before it scores a submission at full
+  density), then bad-2 is counted over every pixel of the region (density 100 %).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["THRESHOLDS", "visible_mask", "scores"]
+__all__ = ["THRESHOLDS", "visible_mask", "fill_background", "scores"]
 
 #: The bad-pixel thresholds (px).
 THRESHOLDS = (1.0, 2.0, 4.0)
@@ -52,9 +55,41 @@ def visible_mask(gt, tolerance: float = 1.0) -> np.ndarray:
     return out
 
 
+def _fill_rows(d: np.ndarray) -> np.ndarray:
+    """Each row's holes: the smaller of the two valid values around a gap, the nearest one at a row's ends."""
+    h, w = d.shape
+    valid = np.isfinite(d)
+    idx = np.broadcast_to(np.arange(w), (h, w))
+    left = np.maximum.accumulate(np.where(valid, idx, -1), axis=1)             # last valid at or before x
+    right = np.minimum.accumulate(np.where(valid, idx, w)[:, ::-1], axis=1)[:, ::-1]  # first at or after x
+    rows = np.arange(h)[:, None]
+    lv = np.where(left >= 0, d[rows, np.clip(left, 0, w - 1)], np.nan)
+    rv = np.where(right < w, d[rows, np.clip(right, 0, w - 1)], np.nan)
+    # fmin: the smaller where both exist (the farther surface: a hole is most often what a nearer object
+    # hides), the one that exists at a row's ends; NaN where the row has nothing valid
+    return np.where(valid, d, np.fmin(lv, rv))
+
+
+def fill_background(disparity) -> np.ndarray:
+    """A full map from one with holes (NaN), the way KITTI's devkit fills a submission before scoring it.
+
+    Along each row, a gap between two valid pixels takes the smaller (farther) of their two disparities and
+    a gap at a row's end the nearest valid value of the row. A row with nothing valid is then filled the same
+    way along its column from the filled rows: above the first or below the last filled row the nearest one's
+    value (KITTI's extrapolation to the top and bottom); between two filled rows the smaller of the two (KITTI
+    leaves such a row invalid; ours is the row rule turned by 90 degrees). Only a map with no valid pixel at
+    all stays NaN."""
+    d = np.asarray(disparity, np.float64)
+    if d.ndim != 2:
+        raise ValueError(f"disparity map must be 2-D, got shape {d.shape}")
+    # after the row pass every row is full or empty: the column pass changes the empty rows only
+    return _fill_rows(_fill_rows(d).T).T
+
+
 def scores(disparity, gt, *, visible=None) -> dict[str, float]:
     """The measures of a float map (NaN = no estimate): ``bad1/bad2/bad4_noc``, ``..._all``, ``density``
-    (all), ``rms`` (noc), ``bad2_filled`` (noc). ``visible``: the noc mask (default :func:`visible_mask`)."""
+    (all), ``rms`` (noc), ``bad2_filled`` (noc), ``bad2_interp`` (noc, on :func:`fill_background`'s map).
+    ``visible``: the noc mask (default :func:`visible_mask`)."""
     d = np.asarray(disparity, np.float64)
     g = _check_gt(gt)
     if d.shape != g.shape:
@@ -73,6 +108,10 @@ def scores(disparity, gt, *, visible=None) -> dict[str, float]:
             out["rms"] = float(np.sqrt(np.mean(err[est] ** 2))) if n else float("nan")
             total = int(np.count_nonzero(sel))
             out["bad2_filled"] = 100.0 * (np.count_nonzero(est & (err > 2.0)) + total - n) / total if total \
+                else float("nan")
+            filled = np.abs(fill_background(d) - np.where(np.isfinite(g), g, 0.0))
+            # NaN (a map with nothing valid) compares False: counted bad by counting the good ones
+            out["bad2_interp"] = 100.0 * (total - np.count_nonzero(sel & (filled <= 2.0))) / total if total \
                 else float("nan")
         else:
             out["density"] = 100.0 * n / max(1, int(np.count_nonzero(sel)))
