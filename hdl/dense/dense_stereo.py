@@ -14,12 +14,19 @@ from eyestereo.tools.models.dense_stereo import DEFAULTS, WIDTHS
 from eyestereo.tools.models.sgm import D_RANGE, PATHS
 
 
+def fifo_depth(window: int, width: int) -> int:
+    """sgm's FIFO in the chain: a power of two that holds census's frame tail (``window // 2`` lines and
+    pixels, pushed out at up to a pixel per two clocks after the frame's last beat) and 64 more."""
+    r = window // 2
+    return 1 << (r * width + r + 64 - 1).bit_length()
+
+
 @block
 def dense_stereo(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun, *,
                  window: int = DEFAULTS["window"], disparities: int = DEFAULTS["disparities"], pu: int = 4,
                  paths: int = DEFAULTS["paths"], median: bool = DEFAULTS["median"],
                  path_bits: int = WIDTHS["path_bits"], sum_shift: int = WIDTHS["sum_shift"],
-                 frac_bits: int = WIDTHS["frac_bits"], fifo: int = 16, width: int = FRAME_WIDTH,
+                 frac_bits: int = WIDTHS["frac_bits"], fifo: int | None = None, width: int = FRAME_WIDTH,
                  height: int = FRAME_HEIGHT):
     """Disparity codes of the left image of a rectified stereo stream
     (:func:`eyestereo.tools.models.dense_stereo.dense_stereo`, bit for bit).
@@ -39,8 +46,11 @@ def dense_stereo(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel,
         overrun: sgm's FIFO lost a pixel (sticky until ``rst`` or a reset token).
 
     Parameters:
-        window, disparities, pu, paths, path_bits, sum_shift, frac_bits, fifo: as :func:`sgm` (and
-            census's window). median: the 3 x 3 median after sgm (an elaboration choice: without it the
+        window, disparities, pu, paths, path_bits, sum_shift, frac_bits: as :func:`sgm` (and census's
+            window). fifo: sgm's input FIFO; None (default): the power of two that holds the census's frame
+            tail, ``window // 2`` lines + ``window // 2`` pixels + 64, which census pushes out at up to a pixel
+            per two clocks after the frame's last beat (352 x 288, 5 x 5: 1024).
+        median: the 3 x 3 median after sgm (an elaboration choice: without it the
             block is smaller and one row + 8 clocks faster). width, height: the frame.
 
     Latency: census's (window // 2 rows and pixels + window + 3 clocks), then sgm's (a row's codes follow
@@ -64,11 +74,13 @@ def dense_stereo(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel,
     disparities = check_int("disparities", disparities, *D_RANGE)
     pu = check_choice("pu", pu, PU_CHOICES)
     paths = check_choice("paths", paths, PATHS)
-    fifo = check_int("fifo", fifo, 2, 4096)
+    width, height = check_frame(width, height)
+    if fifo is None:
+        fifo = fifo_depth(window, width)
+    fifo = check_int("fifo", fifo, 2, 1 << 14)
     path_bits, sum_shift, frac_bits = (check_int(n, v) for n, v in (("path_bits", path_bits),
                                                                     ("sum_shift", sum_shift),
                                                                     ("frac_bits", frac_bits)))
-    width, height = check_frame(width, height)
     if width <= disparities:
         raise block_error(f"frame {width}x{height}: width must exceed the {disparities} disparities")
     words = ImageStream(census_bits(window), stereo=True)

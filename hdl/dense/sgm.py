@@ -9,9 +9,16 @@ from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 from eyestereo.tools.models.census import WINDOWS, census_bits
 from eyestereo.tools.models.sgm import D_RANGE, INVALID, PATHS, check_params
 
+#: Pipeline stages, counted from a group's beat (stage 0): the path costs of the group are registered in
+#: stage S_L, their sum in stage S_S.
+S_L = 8
+S_S = S_L + 2
 #: The fewest clocks between two pixels: the previous pixel's path costs are read back from a small RAM
-#: (written 7 clocks after a group's beat) by the same group of the next pixel.
-SPACING_MIN = 8
+#: (written in stage S_L) by the same group of the next pixel.
+SPACING_MIN = S_L + 1
+#: Every memory of the block is named ``*_norw``: none is ever read at the address written in the same clock
+#: (the rings are read a group ahead of their writes, the row and bank RAMs alternate between two rows, the
+#: FIFO never reads its write slot), so Yosys may leave out its collision logic (hdl/flow/netlist.py).
 #: Disparities computed per clock that the block offers (powers of two, dividing D).
 PU_CHOICES = (1, 2, 4, 8, 16, 32)
 
@@ -27,10 +34,11 @@ def _clog2(n: int) -> int:
     return max(1, (n - 1).bit_length())
 
 
-def tree_latency(n: int) -> int:
-    """Clocks of a minimum over ``n`` values: a register after every two comparator levels (at least one)."""
+def tree_latency(n: int, per_stage: int = 2) -> int:
+    """Clocks of a minimum over ``n`` values: a register after every ``per_stage`` comparator levels (two for
+    the 7-bit path costs, one for the wider keys and sums), and at the end (at least one)."""
     levels = (n - 1).bit_length()
-    return max(1, (levels + 1) // 2)
+    return max(1, (levels + per_stage - 1) // per_stage)
 
 
 def spacing(disparities: int, pu: int) -> int:
@@ -82,17 +90,21 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
         disparities: D, 16..128. pu: disparities per clock, a power of two dividing D with D / pu >= 2.
         paths: 2 or 4. window: the census window (5 or 7): the cost's saturation.
         path_bits, sum_shift, frac_bits: the model's widths (defaults the measured ones).
-        fifo: depth of the input FIFO of pixel pairs (a power of two, 2..4096).
+        fifo: depth of the input FIFO of pixel pairs (a power of two, 2..16384).
         width, height: frame size; width > D.
 
-    Latency: a row's outputs start when its last pixel's left result is written, about
-    ``2 D / PU + 30`` clocks after that pixel leaves the FIFO, and follow one per clock
-    (measured by the bench).
+    Latency: a pixel every :func:`spacing` clocks (D = 64, PU = 4: 18; 54.8 frames/s of 352 x 288 at
+    100 MHz). A row's codes start once its last pixel's result is written and follow one per clock: on a
+    full 352 x 288 Tsukuba frame, 72 to 201 clocks after the row's last input pixel (the FIFO's backlog;
+    docs/dense.md, "Full frames").
 
-    Resources: per path after the first, a ring of ``(width + 1) x 2**ceil(log2(D / PU))`` words of
-    ``PU x path_bits`` bits (block RAM) and a minimum per pixel; PU right-census copies of
+    Resources: per path after the first, a ring of ``2**ceil(log2(width + 1)) x 2**ceil(log2(D / PU))``
+    words of ``PU x path_bits`` bits (a power of two, so that each block RAM holds a slice of every word:
+    no address decoder, no output multiplexer) and a minimum per pixel; PU right-census copies of
     ``2**ceil(log2(D + 1))`` words; 2 x PU banks of ``2 x 2**ceil(log2 width)`` minima; the row RAM of
-    left results; PU Hamming costs, ``paths x PU`` recurrence cells, comparator trees of PU.
+    left results; PU Hamming costs, ``paths x PU`` recurrence cells, comparator trees of PU. Measured
+    (``synth --block sgm``, 352 x 288, D = 64, PU = 4, 4 paths): see docs/dense.md's blocks table; more
+    block RAM than the Spartan-3E 500 and the ECP5-25 have (the dense option targets the ECP5-85).
     """
     check_clock(clk)
     check_reset(rst)
@@ -111,7 +123,7 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
     if dn % pu or dn // pu < 2:
         raise block_error(f"pu={pu} must divide disparities={dn} with at least 2 groups (D / pu >= 2)")
     paths = check_choice("paths", paths, PATHS)
-    fifo = check_int("fifo", fifo, 2, 4096)
+    fifo = check_int("fifo", fifo, 2, 1 << 14)
     if fifo & (fifo - 1):
         raise block_error(f"parameter fifo={fifo} must be a power of two")
     width, height = check_frame(width, height)
@@ -163,7 +175,7 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
         clr.next = rst or tok
 
     fw = fifo.bit_length() - 1
-    fmem = [Signal(intbv(0)[2 * nbits:]) for _ in range(fifo)]
+    fifo_norw = [Signal(intbv(0)[2 * nbits:]) for _ in range(fifo)]
     fwp = Signal(intbv(0)[max(fw, 1):])
     frp = Signal(intbv(0)[max(fw, 1):])
     fcount = Signal(intbv(0, min=0, max=fifo + 1))
@@ -175,12 +187,12 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
     @always(clk.posedge)
     def fifo_write():
         if push and fcount != fifo:
-            fmem[fwp].next = din
+            fifo_norw[fwp].next = din
 
     @always(clk.posedge)
     def fifo_read():
         if pop:
-            fq.next = fmem[frp]
+            fq.next = fifo_norw[frp]
 
     @always_comb
     def popper():
@@ -218,6 +230,10 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
     px = Signal(intbv(0, min=0, max=width))    # the next pixel's position
     py = Signal(intbv(0, min=0, max=height))
     ppos = Signal(intbv(0, min=0, max=ring))   # its place in the previous rows' ring
+    # and the places one and two on (the top and top-right neighbours' of the row before), kept as counters
+    # so that no adder sits before the rings' read addresses
+    ppos1 = Signal(intbv(1 % ring, min=0, max=ring))
+    ppos2 = Signal(intbv(2 % ring, min=0, max=ring))
     pk = Signal(intbv(0)[2:])                  # its bank of the sums RAM
     # the beat (stage 0): a group g of pixel bx
     bv, bfirst, blast = (Signal(bool(0)) for _ in range(3))
@@ -227,6 +243,8 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
     bxm = Signal(intbv(0, min=0, max=mm))      # (x - d0) mod mm
     by = Signal(intbv(0, min=0, max=height))
     bpos = Signal(intbv(0, min=0, max=ring))
+    bpos1 = Signal(intbv(0, min=0, max=ring))
+    bpos2 = Signal(intbv(0, min=0, max=ring))
     bk = Signal(intbv(0)[2:])
     bx0, bxl, by0 = (Signal(bool(0)) for _ in range(3))
 
@@ -238,6 +256,8 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
             px.next = 0
             py.next = 0
             ppos.next = 0
+            ppos1.next = 1 % ring
+            ppos2.next = 2 % ring
             pk.next = 0
         else:
             popd.next = pop
@@ -251,6 +271,8 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
                 bxm.next = px
                 by.next = py
                 bpos.next = ppos
+                bpos1.next = ppos1
+                bpos2.next = ppos2
                 bk.next = pk
                 bx0.next = px == 0
                 bxl.next = px == width - 1
@@ -260,6 +282,14 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
                     ppos.next = 0
                 else:
                     ppos.next = ppos + 1
+                if ppos1 == ring - 1:
+                    ppos1.next = 0
+                else:
+                    ppos1.next = ppos1 + 1
+                if ppos2 == ring - 1:
+                    ppos2.next = 0
+                else:
+                    ppos2.next = ppos2 + 1
                 if px == width - 1:
                     px.next = 0
                     if py == height - 1:
@@ -303,7 +333,7 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
 
     insts += [census_write, left_word]
 
-    # candidates d0 + k <= x, per lane (stage 0), for the costs (stage 4) and the sums (stage 9)
+    # candidates d0 + k <= x, per lane (stage 0), for the costs (stage 4) and the sums (stage S_S)
     cand = [Signal(bool(0)) for _ in range(pu)]
     costs = [Signal(intbv(0, min=0, max=cmax + 1)) for _ in range(pu)]
     for k in range(pu):
@@ -312,7 +342,9 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
     cand4 = Signal(intbv(0)[len(cand_s4):])
     insts.append(delay(clk, cand_s4, cand4, clocks=4))
     for k in range(pu):
-        insts.append(cost_lane(clk, cwe, cwa, cwd, bxm, cl_pix, cand4, costs[k], k=k, pu=pu, rr=rr, mm=mm,
+        xk = Signal(intbv(0, min=0, max=mm))
+        insts.append(lane_counter(clk, popd, bv, blast, px, xk, k=k, pu=pu, mm=mm))
+        insts.append(cost_lane(clk, cwe, cwa, cwd, xk, cl_pix, cand4, costs[k], k=k, pu=pu, rr=rr, mm=mm,
                                cmax=cmax))
 
     # ------------------------------------------------------------------ path costs
@@ -323,16 +355,16 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
     last3 = _like(blast)
     insts.append(pipe(clk, clr, blast, last3, clocks=3))
     v7 = _like(bv)
-    insts.append(pipe(clk, clr, bv, v7, clocks=7))
+    insts.append(pipe(clk, clr, bv, v7, clocks=S_L))
     first7 = _like(bfirst)
-    insts.append(pipe(clk, clr, bfirst, first7, clocks=7))
+    insts.append(pipe(clk, clr, bfirst, first7, clocks=S_L))
     last7 = _like(blast)
-    insts.append(pipe(clk, clr, blast, last7, clocks=7))
+    insts.append(pipe(clk, clr, blast, last7, clocks=S_L))
     g7 = _like(bg)
-    insts.append(pipe(clk, clr, bg, g7, clocks=7))
+    insts.append(pipe(clk, clr, bg, g7, clocks=S_L))
     pos7 = _like(bpos)
-    insts.append(pipe(clk, clr, bpos, pos7, clocks=7))
-    lpaths = []                                # per path: PU lanes of L (stage 7)
+    insts.append(pipe(clk, clr, bpos, pos7, clocks=S_L))
+    lpaths = []                                # per path: PU lanes of L (stage S_L)
     for dx, dy in dirs:
         lanes = [Signal(intbv(0)[pb:]) for _ in range(pu)]
         if dy == 0:
@@ -345,32 +377,33 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
         else:
             start = Signal(bool(0))
             insts.append(either(bxl, by0, start))
-        insts.append(path(clk, clr, bv, bg, bpos, start, first3, last3, v7, first7, last7, g7, pos7, costs, lanes,
+        rpos = (bpos, bpos1, bpos2)[dx + 1]  # where this path's p - r sits in the ring
+        insts.append(path(clk, clr, bv, bg, rpos, start, first3, last3, v7, first7, last7, g7, pos7, costs, lanes,
                           p1, p2, dx=dx, dy=dy, pu=pu, ng=ng, npw=npw, ring=ring, pb=pb, tl=tl))
         lpaths.append(lanes)
 
-    # ------------------------------------------------------------------ sums, stage 9
+    # ------------------------------------------------------------------ sums, stage S_S
     sums = [Signal(intbv(0)[sb:]) for _ in range(pu)]
     for k in range(pu):
         insts.append(path_sum(clk, [lanes[k] for lanes in lpaths], sums[k], shift=sum_shift))
     v9 = _like(bv)
-    insts.append(pipe(clk, clr, bv, v9, clocks=9))
+    insts.append(pipe(clk, clr, bv, v9, clocks=S_S))
     first9 = _like(bfirst)
-    insts.append(pipe(clk, clr, bfirst, first9, clocks=9))
+    insts.append(pipe(clk, clr, bfirst, first9, clocks=S_S))
     last9 = _like(blast)
-    insts.append(pipe(clk, clr, blast, last9, clocks=9))
+    insts.append(pipe(clk, clr, blast, last9, clocks=S_S))
     d09 = _like(bd0)
-    insts.append(pipe(clk, clr, bd0, d09, clocks=9))
+    insts.append(pipe(clk, clr, bd0, d09, clocks=S_S))
     cand9 = Signal(intbv(0)[len(cand_s4):])
-    insts.append(delay(clk, cand_s4, cand9, clocks=9))
+    insts.append(delay(clk, cand_s4, cand9, clocks=S_S))
     k9 = _like(bk)
-    insts.append(pipe(clk, clr, bk, k9, clocks=9))
+    insts.append(pipe(clk, clr, bk, k9, clocks=S_S))
     g9 = _like(bg)
-    insts.append(pipe(clk, clr, bg, g9, clocks=9))
+    insts.append(pipe(clk, clr, bg, g9, clocks=S_S))
     x9 = _like(bx)
-    insts.append(pipe(clk, clr, bx, x9, clocks=9))
+    insts.append(pipe(clk, clr, bx, x9, clocks=S_S))
     y9 = _like(by)
-    insts.append(pipe(clk, clr, by, y9, clocks=9))
+    insts.append(pipe(clk, clr, by, y9, clocks=S_S))
     yb = Signal(bool(0))
 
     @always_comb
@@ -395,10 +428,10 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
     # right disparities: per bank k the running minimum key (sum, d) of right pixel x - d, d = k mod PU
     kb = sb + db
     xm7 = _like(bxm)
-    insts.append(pipe(clk, clr, bxm, xm7, clocks=7))
+    insts.append(pipe(clk, clr, bxm, xm7, clocks=S_S - 3))
     y7b = Signal(bool(0))
     y7 = _like(by)
-    insts.append(pipe(clk, clr, by, y7, clocks=7))
+    insts.append(pipe(clk, clr, by, y7, clocks=S_S - 3))
 
     @always_comb
     def row_bit7():
@@ -416,8 +449,8 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
     for k in range(pu):
         insts.append(wta_key(sums[k], d09, cand9, keys[k], k=k, db=db, kb=kb))
     gbest = Signal(intbv(0)[kb + 1:])
-    insts.append(min_tree(clk, keys, gbest))
-    tw = 9 + tl
+    insts.append(min_tree(clk, keys, gbest, per_stage=1))
+    tw = S_S + tree_latency(pu, 1)
     vw = _like(bv)
     insts.append(pipe(clk, clr, bv, vw, clocks=tw))
     firstw = _like(bfirst)
@@ -536,12 +569,34 @@ def candidate(x, d0, cand, *, k: int):
 
 
 @block
+def lane_counter(clk, load, step, last, x, xk, *, k: int, pu: int, mm: int):
+    """Lane k's right pixel ``(x - d0 - k) mod mm`` of the beat, as a counter beside the sequencer's: loaded
+    with the pixel, then PU less per group."""
+
+    @always(clk.posedge)
+    def count():
+        if load:
+            if x >= k:
+                xk.next = x - k
+            else:
+                xk.next = x + (mm - k)
+        elif step and not last:
+            if xk >= pu:
+                xk.next = xk - pu
+            else:
+                xk.next = xk + (mm - pu)
+
+    return count
+
+
+@block
 def cost_lane(clk, we, wa, wd, xm, cl, cand4, cost, *, k: int, pu: int, rr: int, mm: int, cmax: int):
-    """Lane k: its copy of the right census ring, read at (x - d0 - k) mod rr (stage 0), registered twice
+    """Lane k: its copy of the right census ring, read at (x - d0 - k) mod rr (stage 0: ``xm``, the lane's own
+    counter, so no subtraction comes before the RAM's address), registered twice
     (stages 1, 2), the Hamming distance to the left word in 6-bit chunks (stage 3) and their sum (stage 4),
     saturated at cmax, and cmax for a non-candidate (stage 5)."""
     nbits = len(wd)
-    mem = [Signal(intbv(0)[nbits:]) for _ in range(rr)]
+    census_norw = [Signal(intbv(0)[nbits:]) for _ in range(rr)]
     rb = rr.bit_length() - 1
     ra = Signal(intbv(0)[rb:])
     q = Signal(intbv(0)[nbits:])
@@ -553,18 +608,13 @@ def cost_lane(clk, we, wa, wd, xm, cl, cand4, cost, *, k: int, pu: int, rr: int,
 
     @always_comb
     def addr():
-        t = intbv(0, min=0, max=mm)
-        if xm >= k:
-            t[:] = xm - k
-        else:
-            t[:] = xm + (mm - k)
-        ra.next = t[rb:]
+        ra.next = xm[rb:]
 
     @always(clk.posedge)
     def ram():
         if we:
-            mem[wa].next = wd
-        q.next = mem[ra]
+            census_norw[wa].next = wd
+        q.next = census_norw[ra]
 
     @always(clk.posedge)
     def out_reg():
@@ -635,7 +685,7 @@ def add2(a, b, s):
 
 
 @block
-def path(clk, clr, bv, bg, bpos, start, first3, last3, v7, first7, last7, g7, pos7, costs, lanes, p1, p2, *,
+def path(clk, clr, bv, bg, rpos, start, first3, last3, v7, first7, last7, g7, pos7, costs, lanes, p1, p2, *,
          dx: int, dy: int, pu: int, ng: int, npw: int, ring: int, pb: int, tl: int):
     """One aggregation path: the previous values of p - r (stage 0 read, stages 1-4 registered), the
     recurrence of each lane (stages 3-7), the path's minimum per pixel (the tree over the lanes, then
@@ -645,8 +695,8 @@ def path(clk, clr, bv, bg, bpos, start, first3, last3, v7, first7, last7, g7, po
     q = Signal(intbv(0)[ww:])
     w2, w3, w4 = (Signal(intbv(0)[ww:]) for _ in range(3))
     insts = []
-    # the minimum of p - r, at stage 6
-    m6 = Signal(intbv(0)[pb:])
+    # the minimum of p - r, at stage S_L - 1 (the recurrence's last)
+    mloop = Signal(intbv(0)[pb:])
     gmin = Signal(intbv(0)[pb:])
     insts.append(min_tree(clk, list(lanes), gmin))
     vw = Signal(bool(0))
@@ -660,7 +710,7 @@ def path(clk, clr, bv, bg, bpos, start, first3, last3, v7, first7, last7, g7, po
     start3 = Signal(bool(0))
     insts.append(delay_clr(clk, clr, start, start3, clocks=3))
     start6 = Signal(bool(0))
-    insts.append(delay_clr(clk, clr, start, start6, clocks=6))
+    insts.append(delay_clr(clk, clr, start, start6, clocks=S_L - 1))
 
     @always(clk.posedge)
     def minimum():
@@ -674,54 +724,48 @@ def path(clk, clr, bv, bg, bpos, start, first3, last3, v7, first7, last7, g7, po
 
     insts.append(minimum)
     if dy == 0:
-        # the previous pixel's path costs: npw words, read by group (stage 0), written by group (stage 7)
-        mem = [Signal(intbv(0)[ww:]) for _ in range(npw)]
+        # the previous pixel's path costs: npw words, read by group (stage 0), written by group (stage S_L)
+        prev_norw = [Signal(intbv(0)[ww:]) for _ in range(npw)]
 
         @always(clk.posedge)
         def left_ram():
             if v7:
-                mem[g7].next = word
-            q.next = mem[bg]
+                prev_norw[g7].next = word
+            q.next = prev_norw[bg]
 
         @always_comb
         def left_min():
             if start6:
-                m6.next = 0
+                mloop.next = 0
             else:
-                m6.next = fin
+                mloop.next = fin
 
         insts += [left_ram, left_min]
     else:
         # the previous row's: a ring of width + 1 pixels (read at the pixel's own place for the top-left
         # neighbour, one and two places on for the top and top-right), written where read (read first)
-        off = dx + 1
-        mem = [Signal(intbv(0)[ww:]) for _ in range(ring * npw)]
-        mins = [Signal(intbv(0)[pb:]) for _ in range(ring)]
-        ra = Signal(intbv(0, min=0, max=ring))
+        # a power of two of words (the place's bits, then the group's): each block RAM then holds a slice of
+        # every word at the full address (ECP5: 8K x 2), with no address decoder before the RAMs and no
+        # multiplexer after them -- both were the slowest paths when the ring took only ring x npw words
+        ring_norw = [Signal(intbv(0)[ww:]) for _ in range(1 << (len(pos7) + len(g7)))]
+        mins_norw = [Signal(intbv(0)[pb:]) for _ in range(ring)]
         mq, mr = Signal(intbv(0)[pb:]), Signal(intbv(0)[pb:])
         posw = _like(pos7)
-        insts.append(delay(clk, pos7, posw, clocks=tl))
+        insts.append(delay(clk, pos7, posw, clocks=tl + 1))
         mwe = Signal(bool(0))
         mwd = Signal(intbv(0)[pb:])
-
-        @always_comb
-        def ring_addr():
-            t = intbv(0, min=0, max=ring + off)
-            t[:] = bpos + off
-            if t >= ring:
-                ra.next = t - ring
-            else:
-                ra.next = t
 
         @always(clk.posedge)
         def ring_ram():
             if v7:
-                mem[concat(pos7, g7)].next = word
-            q.next = mem[concat(ra, bg)]
+                ring_norw[concat(pos7, g7)].next = word
+            q.next = ring_norw[concat(rpos, bg)]
 
-        @always_comb
+        @always(clk.posedge)
         def min_write():
-            mwe.next = vw and lastw
+            # registered: the pixel's minimum is written a clock after it is known (its next reader is a
+            # row away), so the comparison does not end at the block RAM
+            mwe.next = vw and lastw and not clr
             if firstw or gmin < run:
                 mwd.next = gmin
             else:
@@ -730,23 +774,23 @@ def path(clk, clr, bv, bg, bpos, start, first3, last3, v7, first7, last7, g7, po
         @always(clk.posedge)
         def min_ram():
             if mwe:
-                mins[posw].next = mwd
-            mq.next = mins[ra]
+                mins_norw[posw].next = mwd
+            mq.next = mins_norw[rpos]
 
         @always(clk.posedge)
         def min_regs():
             mr.next = mq
 
-        insts += [ring_addr, ring_ram, min_write, min_ram, min_regs]
+        insts += [ring_ram, min_write, min_ram, min_regs]
         mr6 = _like(mr)
-        insts.append(delay(clk, mr, mr6, clocks=4))
+        insts.append(delay(clk, mr, mr6, clocks=S_L - 3))
 
         @always_comb
         def top_min():
             if start6:
-                m6.next = 0
+                mloop.next = 0
             else:
-                m6.next = mr6
+                mloop.next = mr6
 
         insts.append(top_min)
 
@@ -761,51 +805,68 @@ def path(clk, clr, bv, bg, bpos, start, first3, last3, v7, first7, last7, g7, po
         own = w3(k * pb + pb, k * pb)
         prv = w3(k * pb, (k - 1) * pb) if k > 0 else w4(ww, ww - pb)
         nxt = w3(k * pb + 2 * pb, k * pb + pb) if k < pu - 1 else w2(pb, 0)
-        insts.append(path_cell(clk, own, prv, nxt, start3, first3, last3, costs[k], m6, p1, p2, lanes[k], pb=pb,
+        insts.append(path_cell(clk, own, prv, nxt, start3, first3, last3, costs[k], mloop, p1, p2, lanes[k], pb=pb,
                                at_first=k == 0, at_last=k == pu - 1))
     return insts
 
 
 @block
-def path_cell(clk, own, prv, nxt, start3, first3, last3, cost5, m6, p1, p2, lane, *, pb: int, at_first: bool,
+def path_cell(clk, own, prv, nxt, start3, first3, last3, cost5, m7, p1, p2, lane, *, pb: int, at_first: bool,
               at_last: bool):
     """One disparity of one path: ``L = C + min(Lp(d), Lp(d -+ 1) + P1, minLp + P2) - minLp``, saturated,
     as ``min(C + m1 - minLp, min(C + P2, sat))`` with ``m1 = min(Lp(d), Lp(d -+ 1) + P1)``: only the last
-    stage needs the previous pixel's minimum, which is what keeps the left path's loop short."""
+    stage needs the previous pixel's minimum, which is what keeps the left path's loop short.
+
+    Stages (one carry chain each, at most two side by side): 3 the neighbours plus P1; 4 the minimum of
+    three (three comparisons at once); 5 ``av = C + m1`` and ``bs = min(C + P2, sat)``; 6 ``e = av - bs``
+    and whether it is negative; 7 (the loop's stage) ``L = av - minLp`` where ``e < minLp``, else ``bs``:
+    ``av - minLp < bs`` without a second chain after the subtraction. ``lane`` is registered in S_L."""
     sat = (1 << pb) - 1
+    big = sat + 256
+    own4, a4, b4 = (Signal(intbv(0, min=0, max=big)) for _ in range(3))
     m1 = Signal(intbv(0)[pb:])
-    m1d = Signal(intbv(0)[pb:])
     cmx = cost5.max
     av = Signal(intbv(0, min=0, max=cmx + sat + 1))
     bs = Signal(intbv(0)[pb:])
+    av7 = Signal(intbv(0, min=0, max=cmx + sat + 1))
+    bs7 = Signal(intbv(0)[pb:])
+    e7 = Signal(intbv(0, min=0, max=cmx + sat + 1))
+    neg7 = Signal(bool(0))
 
     @always(clk.posedge)
     def stage3():
-        m = intbv(0, min=0, max=sat + 256)
+        # sums in variables of their full width: a comparison of a sum would be cut to its operands'
         if start3:
-            m[:] = 0
+            own4.next = 0
+            a4.next = big - 1
+            b4.next = big - 1
         else:
-            m[:] = own
-            # sums in variables of their full width: a comparison of a sum would be cut to its operands'
-            a = intbv(0, min=0, max=sat + 256)
-            a[:] = prv + p1
-            b = intbv(0, min=0, max=sat + 256)
-            b[:] = nxt + p1
-            if not (at_first and first3):
-                if a < m:
-                    m[:] = a
-            if not (at_last and last3):
-                if b < m:
-                    m[:] = b
-        m1.next = m
+            own4.next = own
+            if at_first and first3:
+                a4.next = big - 1          # d - 1 < 0: left out of the minimum
+            else:
+                a4.next = prv + p1
+            if at_last and last3:
+                b4.next = big - 1          # d + 1 > D - 1: left out
+            else:
+                b4.next = nxt + p1
 
     @always(clk.posedge)
     def stage4():
-        m1d.next = m1
+        # the smallest of three, the first of equal ones: three comparisons side by side, then a choice
+        oa = own4 <= a4
+        ob = own4 <= b4
+        ab = a4 <= b4
+        if oa and ob:
+            m1.next = own4
+        elif ab:
+            m1.next = a4
+        else:
+            m1.next = b4
 
     @always(clk.posedge)
     def stage5():
-        av.next = cost5 + m1d
+        av.next = cost5 + m1
         c = intbv(0, min=0, max=cmx + 256)
         c[:] = cost5 + p2
         if c > sat:
@@ -815,21 +876,33 @@ def path_cell(clk, own, prv, nxt, start3, first3, last3, cost5, m6, p1, p2, lane
 
     @always(clk.posedge)
     def stage6():
-        # av >= m6 on every beat (m1 >= minLp); the first test only keeps idle clocks' garbage in range
-        t = intbv(0, min=0, max=av.max)
-        if av >= m6:
-            t[:] = av - m6
-        if t < bs:
+        av7.next = av
+        bs7.next = bs
+        if av >= bs:
+            e7.next = av - bs
+            neg7.next = False
+        else:
+            e7.next = 0
+            neg7.next = True
+
+    @always(clk.posedge)
+    def stage7():
+        # av - minLp < bs  <=>  av - bs < minLp; av >= minLp on every beat (m1 >= minLp), the test keeps
+        # idle clocks' garbage in range
+        t = intbv(0, min=0, max=av7.max)
+        if av7 >= m7:
+            t[:] = av7 - m7
+        if neg7 or e7 < m7:
             lane.next = t
         else:
-            lane.next = bs
+            lane.next = bs7
 
-    return stage3, stage4, stage5, stage6
+    return stage3, stage4, stage5, stage6, stage7
 
 
 @block
 def path_sum(clk, ls, out, *, shift: int):
-    """The sum of the paths' lane (stage 8: pairs, stage 9: the total with ``shift`` bits dropped)."""
+    """The sum of the paths' lane (stage S_L + 1: pairs, stage S_S: the total with ``shift`` bits dropped)."""
     a, b = ls[0], ls[1]
     c, d = (ls[2], ls[3]) if len(ls) == 4 else (None, None)
     pbw = len(a) + 1
@@ -857,9 +930,9 @@ def path_sum(clk, ls, out, *, shift: int):
 
 
 @block
-def min_tree(clk, keys, out):
-    """``out`` = the smallest of ``keys`` (the first of equal ones), a register after every two levels of
-    comparators and at the end: :func:`tree_latency` clocks."""
+def min_tree(clk, keys, out, *, per_stage: int = 2):
+    """``out`` = the smallest of ``keys`` (the first of equal ones), a register after every ``per_stage``
+    levels of comparators and at the end: :func:`tree_latency` clocks."""
     insts = []
     level = list(keys)
     depth = 0
@@ -872,7 +945,7 @@ def min_tree(clk, keys, out):
         if len(level) % 2:
             nxt.append(level[-1])
         depth += 1
-        if depth % 2 == 0 and len(nxt) > 1:
+        if depth % per_stage == 0 and len(nxt) > 1:
             regd = [Signal(intbv(0)[len(out):]) for _ in nxt]
             insts += [delay(clk, a, b, clocks=1) for a, b in zip(nxt, regd)]
             nxt = regd
@@ -898,13 +971,13 @@ def right_bank(clk, yb7, xm7, v9, first9, cand9, s9, d09, drain_addr, drain_q, *
                xw: int, db: int):
     """Bank k of the right disparities: the running minimum key (sum, d) of right pixel xr over the
     disparities d = k mod PU (candidates of left pixels xr + d), row by row (two rows: the drain reads one
-    while the next is computed). Read at stage 7, registered twice, compared and written at stage 9; a
-    second copy takes the same writes for the drain's reads."""
+    while the next is computed). Read at stage S_S - 2, registered twice, compared and written at stage S_S; a
+    second copy_norw takes the same writes for the drain's reads."""
     sb = len(s9)
     kb = sb + db
     depth = 2 << xw
-    rmw = [Signal(intbv(0)[kb:]) for _ in range(depth)]
-    copy = [Signal(intbv(0)[kb:]) for _ in range(depth)]
+    rmw_norw = [Signal(intbv(0)[kb:]) for _ in range(depth)]
+    copy_norw = [Signal(intbv(0)[kb:]) for _ in range(depth)]
     ra = Signal(intbv(0)[xw + 1:])
     wa = Signal(intbv(0)[xw + 1:])
     q, qr = Signal(intbv(0)[kb:]), Signal(intbv(0)[kb:])
@@ -912,8 +985,9 @@ def right_bank(clk, yb7, xm7, v9, first9, cand9, s9, d09, drain_addr, drain_q, *
     key = Signal(intbv(0)[kb:])
     insts = []
 
-    @always_comb
+    @always(clk.posedge)
     def addr():
+        # from the stage before the read: the subtraction ends in a register, not at the RAM
         xr = intbv(0, min=0, max=mm)
         if xm7 >= k:
             xr[:] = xm7 - k
@@ -927,7 +1001,7 @@ def right_bank(clk, yb7, xm7, v9, first9, cand9, s9, d09, drain_addr, drain_q, *
 
     @always(clk.posedge)
     def read():
-        q.next = rmw[ra]
+        q.next = rmw_norw[ra]
         qr.next = q
 
     @always_comb
@@ -943,13 +1017,13 @@ def right_bank(clk, yb7, xm7, v9, first9, cand9, s9, d09, drain_addr, drain_q, *
     @always(clk.posedge)
     def write():
         if we:
-            rmw[wa].next = key
+            rmw_norw[wa].next = key
 
     @always(clk.posedge)
     def write_copy():
         if we:
-            copy[wa].next = key
-        drain_q.next = copy[drain_addr]
+            copy_norw[wa].next = key
+        drain_q.next = copy_norw[drain_addr]
 
     insts += [read, update, write, write_copy]
     return insts
@@ -981,7 +1055,7 @@ def second_pass(clk, clr, we, wa, wd, go, fin, fx, fy, fk, uniqueness, subpixel,
     more than one disparity from the winner dL among the candidates, and the sums at dL - 1 and dL + 1;
     then the uniqueness test, the sub-pixel parabola (a restoring divider, one step per clock) and the code."""
     ww = pu * sb
-    mem = [Signal(intbv(0)[ww:]) for _ in range(4 << gb)]
+    sums_norw = [Signal(intbv(0)[ww:]) for _ in range(4 << gb)]
     ra = Signal(intbv(0)[2 + gb:])
     q, qr = Signal(intbv(0)[ww:]), Signal(intbv(0)[ww:])
     sv = Signal(bool(0))
@@ -991,13 +1065,17 @@ def second_pass(clk, clr, we, wa, wd, go, fin, fx, fy, fk, uniqueness, subpixel,
     sbest = Signal(intbv(0)[sb:])
     sx = Signal(intbv(0, min=0, max=width))
     sy = Signal(intbv(0, min=0, max=height))
+    sdb = Signal(intbv(0, min=0, max=dn))      # the first disparity of the word being read
+    sdlp = Signal(intbv(0, min=0, max=dn + 1))
+    sdlm1, sdlm2 = Signal(intbv(0, min=0, max=dn)), Signal(intbv(0, min=0, max=dn))
+    has1, has2 = Signal(bool(0)), Signal(bool(0))
     insts = []
 
     @always(clk.posedge)
     def sums_ram():
         if we:
-            mem[wa].next = wd
-        q.next = mem[ra]
+            sums_norw[wa].next = wd
+        q.next = sums_norw[ra]
         qr.next = q
 
     @always_comb
@@ -1012,16 +1090,32 @@ def second_pass(clk, clr, we, wa, wd, go, fin, fx, fy, fk, uniqueness, subpixel,
         elif go:
             sv.next = True
             sh.next = 0
+            sdb.next = 0
             sk.next = fk
             sdl.next = fin[db:]
             sbest.next = fin[sb + db:db]
             sx.next = fx
             sy.next = fy
+            # the winner's neighbourhood as registers, so that each lane only compares
+            w = intbv(0)[db:]
+            w[:] = fin[db:]
+            sdlp.next = w + 1
+            has1.next = w >= 1
+            has2.next = w >= 2
+            if w >= 1:
+                sdlm1.next = w - 1
+            else:
+                sdlm1.next = 0
+            if w >= 2:
+                sdlm2.next = w - 2
+            else:
+                sdlm2.next = 0
         elif sv:
             if sh == ng - 1:
                 sv.next = False
             else:
                 sh.next = sh + 1
+                sdb.next = sdb + pu
 
     insts += [sums_ram, read_addr, scanner]
     sv2 = Signal(bool(0))
@@ -1041,11 +1135,16 @@ def second_pass(clk, clr, we, wa, wd, go, fin, fx, fy, fk, uniqueness, subpixel,
     far = [Signal(intbv(0)[sb + 1:]) for _ in range(pu)]
     cm_l = [Signal(intbv(0)[sb:]) for _ in range(pu)]
     cp_l = [Signal(intbv(0)[sb:]) for _ in range(pu)]
+    sdb1 = _like(sdb)
+    insts.append(delay(clk, sdb, sdb1, clocks=1))
     for i in range(pu):
-        insts.append(second_lane(clk, qr, sh2, sdl, sx, far[i], cm_l[i], cp_l[i], i=i, pu=pu, sb=sb))
+        di = Signal(intbv(0, min=0, max=dn))
+        insts.append(lane_disparity(clk, sdb1, di, i=i))
+        insts.append(second_lane(clk, qr, di, sdlp, sdlm1, sdlm2, has1, has2, sx, far[i], cm_l[i], cp_l[i], i=i,
+                                 sb=sb))
     sec_g = Signal(intbv(0)[sb + 1:])
-    insts.append(min_tree(clk, far, sec_g))
-    tl = tree_latency(pu)
+    insts.append(min_tree(clk, far, sec_g, per_stage=1))
+    tl = tree_latency(pu, 1)
     cm_g, cp_g = Signal(intbv(0)[sb:]), Signal(intbv(0)[sb:])
     insts.append(or_reduce(clk, cm_l, cm_g, clocks=tl))
     insts.append(or_reduce(clk, cp_l, cp_g, clocks=tl))
@@ -1118,30 +1217,35 @@ def second_pass(clk, clr, we, wa, wd, go, fin, fx, fy, fk, uniqueness, subpixel,
 
 
 @block
-def second_lane(clk, qr, sh2, sdl, sx, far, cm, cp, *, i: int, pu: int, sb: int):
-    """Lane i of a word of sums (d = h PU + i): its sum for the second best (a candidate, |d - dL| > 1;
-    else all ones), and for dL - 1 and dL + 1 (else 0), registered."""
+def lane_disparity(clk, base, d, *, i: int):
+    """Lane i's disparity of the word read, registered: ``base + i``."""
+
+    @always(clk.posedge)
+    def logic():
+        d.next = base + i
+
+    return logic
+
+
+@block
+def second_lane(clk, qr, d, sdlp, sdlm1, sdlm2, has1, has2, sx, far, cm, cp, *, i: int, sb: int):
+    """Lane i of a word of sums (disparity ``d``): its sum for the second best (a candidate, |d - dL| > 1;
+    else all ones), and for dL - 1 and dL + 1 (else 0), registered. The winner's neighbours come as
+    registers (dL + 1, dL - 1, dL - 2 and whether the last two exist): comparisons only."""
     none = (1 << (sb + 1)) - 1
 
     @always(clk.posedge)
     def logic():
-        d = intbv(0, min=0, max=(sh2.max + 1) * pu + 1)
-        d[:] = sh2
-        d[:] = d * pu + i
-        d1 = intbv(0, min=0, max=(sh2.max + 1) * pu + 1)
-        d1[:] = d + 1
-        w1 = intbv(0, min=0, max=sdl.max + 1)
-        w1[:] = sdl + 1
         s = qr[(i + 1) * sb:i * sb]
-        if d <= sx and (d > w1 or d1 < sdl):
+        if d <= sx and (d > sdlp or (has2 and d <= sdlm2)):
             far.next = s
         else:
             far.next = none
-        if d1 == sdl:
+        if has1 and d == sdlm1:
             cm.next = s
         else:
             cm.next = 0
-        if d == w1 and d <= sx:
+        if d == sdlp and d <= sx:
             cp.next = s
         else:
             cp.next = 0
@@ -1196,23 +1300,23 @@ def assign_word(a, b):
 def results(clk, clr, go, sec, cm, cp, dl, best, x, y, uniqueness, subpixel, res_go, res_code, res_dl, res_uv,
             res_x, res_y, *, dn: int, frac_bits: int):
     """Uniqueness (``100 best <= (100 - u) second``), the parabola's offset ``num / (2 den)`` by a restoring
-    divider of ``frac_bits + 1`` steps, and the code ``16 dL + q 2**(4 - frac_bits)``."""
+    divider of ``frac_bits + 1`` steps, and the code ``16 dL + q 2**(4 - frac_bits)``; at most one carry
+    chain per stage (two side by side)."""
     sb = len(best)
     none = (1 << (sb + 1)) - 1
     fb = frac_bits
-    # stage 1: products and the parabola's terms
-    v1 = Signal(bool(0))
-    p100 = Signal(intbv(0)[sb + 7:])
-    pun = Signal(intbv(0)[sb + 7:])
-    found = Signal(bool(0))
-    neg = Signal(bool(0))
+    um = Signal(intbv(0)[7:])
+    # stage 1: the terms
+    v1, found, neg, near_ok = (Signal(bool(0)) for _ in range(4))
+    both = Signal(intbv(0)[sb + 1:])
+    twice = Signal(intbv(0)[sb + 1:])
     an = Signal(intbv(0)[sb + 1:])
-    den = Signal(intbv(0)[sb + 2:])
-    inner = Signal(bool(0))
+    p64 = Signal(intbv(0)[sb + 7:])
+    b4 = Signal(intbv(0)[sb + 7:])
+    pun1 = Signal(intbv(0)[sb + 7:])
     dl1 = Signal(intbv(0, min=0, max=dn))
     x1 = Signal(intbv(0, min=0, max=x.max))
     y1 = Signal(intbv(0, min=0, max=y.max))
-    um = Signal(intbv(0)[7:])
 
     @always(clk.posedge)
     def factor():
@@ -1226,95 +1330,104 @@ def results(clk, clr, go, sec, cm, cp, dl, best, x, y, uniqueness, subpixel, res
         v1.next = go and not clr
         b = intbv(0)[sb + 7:]
         b[:] = best
-        p100.next = (b << 6) + (b << 5) + (b << 2)  # 100 best, in the product's width
+        p64.next = (b << 6) + (b << 5)
+        b4.next = b << 2
         found.next = sec != none
-        pun.next = um * sec[sb:]
+        pun1.next = um * sec[sb:]
+        both.next = cm + cp
+        tw = intbv(0)[sb + 1:]
+        tw[:] = best
+        twice.next = tw << 1
         if cm < cp:
             neg.next = True
             an.next = cp - cm
         else:
             neg.next = False
             an.next = cm - cp
-        both = intbv(0)[sb + 1:]
-        both[:] = cm + cp
-        twice = intbv(0)[sb + 1:]
-        twice[:] = best
-        twice[:] = twice << 1
-        if both > twice:
-            den.next = both - twice
-        else:
-            den.next = 0
-        lim = intbv(0, min=0, max=dn)
-        if x >= dn - 1:
-            lim[:] = dn - 1
-        else:
-            lim[:] = x
-        up = intbv(0, min=0, max=dn + 1)
-        up[:] = dl + 1
-        inner.next = subpixel and dl >= 1 and up <= lim and both > twice
+        # 1 <= dL <= min(D - 1, x) - 1, as comparisons without a sum
+        near_ok.next = subpixel and dl >= 1 and dl < dn - 1 and dl < x
         dl1.next = dl
         x1.next = x
         y1.next = y
 
-    # stage 2: the uniqueness verdict; the divider's dividend
-    v2 = Signal(bool(0))
-    uv2 = Signal(bool(0))
-    rem = [Signal(intbv(0)[sb + 2 + fb:]) for _ in range(fb + 2)]
-    quo = [Signal(intbv(0)[fb + 1:]) for _ in range(fb + 2)]
-
-    rem0, quo0, quof = rem[0], quo[0], quo[fb + 1]
+    # stage 2: 100 best, the parabola's denominator
+    v2, found2, neg2, inner2 = (Signal(bool(0)) for _ in range(4))
+    p100 = Signal(intbv(0)[sb + 7:])
+    pun = Signal(intbv(0)[sb + 7:])
+    an2 = Signal(intbv(0)[sb + 1:])
+    den = Signal(intbv(0)[sb + 2:])
 
     @always(clk.posedge)
     def stage2():
         v2.next = v1 and not clr
-        uv2.next = not found or p100 <= pun
-        rem0.next = an << fb
+        p100.next = p64 + b4
+        pun.next = pun1
+        found2.next = found
+        neg2.next = neg
+        an2.next = an
+        if both > twice:
+            den.next = both - twice
+            inner2.next = near_ok
+        else:
+            den.next = 0
+            inner2.next = False
+
+    # stage 3: the uniqueness verdict; the divider's dividend
+    v3 = Signal(bool(0))
+    uv3 = Signal(bool(0))
+    rem = [Signal(intbv(0)[sb + 2 + fb:]) for _ in range(fb + 2)]
+    quo = [Signal(intbv(0)[fb + 1:]) for _ in range(fb + 2)]
+    rem0, quo0, quof = rem[0], quo[0], quo[fb + 1]
+
+    @always(clk.posedge)
+    def stage3():
+        v3.next = v2 and not clr
+        uv3.next = not found2 or p100 <= pun
+        rem0.next = an2 << fb
         quo0.next = 0
 
-    insts = [factor, stage1, stage2]
-    den_s = [den]
+    insts = [factor, stage1, stage2, stage3]
     for j in range(fb + 1):
         dj = _like(den)
         insts.append(delay(clk, den, dj, clocks=1 + j))
-        den_s.append(dj)
         insts.append(div_step(clk, rem[j], quo[j], dj, rem[j + 1], quo[j + 1], shift=fb - j))
     lat = fb + 1
-    v3 = Signal(bool(0))
-    insts.append(delay_clr(clk, clr, v2, v3, clocks=lat))
-    uv3 = Signal(bool(0))
-    insts.append(delay_clr(clk, clr, uv2, uv3, clocks=lat))
-    neg3 = Signal(bool(0))
-    insts.append(delay_clr(clk, clr, neg, neg3, clocks=lat + 1))
-    inner3 = Signal(bool(0))
-    insts.append(delay_clr(clk, clr, inner, inner3, clocks=lat + 1))
-    dl3 = _like(dl1)
-    insts.append(delay(clk, dl1, dl3, clocks=lat + 1))
-    x3 = _like(x1)
-    insts.append(delay(clk, x1, x3, clocks=lat + 1))
-    y3 = _like(y1)
-    insts.append(delay(clk, y1, y3, clocks=lat + 1))
+    vq = Signal(bool(0))
+    insts.append(delay_clr(clk, clr, v3, vq, clocks=lat))
+    uvq = Signal(bool(0))
+    insts.append(delay_clr(clk, clr, uv3, uvq, clocks=lat))
+    negq = Signal(bool(0))
+    insts.append(delay_clr(clk, clr, neg2, negq, clocks=lat + 1))
+    innerq = Signal(bool(0))
+    insts.append(delay_clr(clk, clr, inner2, innerq, clocks=lat + 1))
+    dlq = _like(dl1)
+    insts.append(delay(clk, dl1, dlq, clocks=lat + 2))
+    xq = _like(x1)
+    insts.append(delay(clk, x1, xq, clocks=lat + 2))
+    yq = _like(y1)
+    insts.append(delay(clk, y1, yq, clocks=lat + 2))
 
     @always(clk.posedge)
     def code():
-        res_go.next = v3 and not clr
+        res_go.next = vq and not clr
         half = intbv(0)[16:]
         half[:] = quof + 1
         half[:] = half >> 1
         half[:] = half << (4 - fb)
         base = intbv(0)[16:]
-        base[:] = dl3
+        base[:] = dlq
         base[:] = base << 4
-        if inner3:
-            if neg3:
+        if innerq:
+            if negq:
                 res_code.next = base - half
             else:
                 res_code.next = base + half
         else:
             res_code.next = base
-        res_dl.next = dl3
-        res_uv.next = uv3
-        res_x.next = x3
-        res_y.next = y3
+        res_dl.next = dlq
+        res_uv.next = uvq
+        res_x.next = xq
+        res_y.next = yq
 
     insts.append(code)
     return insts
@@ -1347,7 +1460,7 @@ def drain(clk, clr, tok, go, code, dl, uv, x, y, drain_addr, drain_q, lr_check, 
     """The row RAM of left results (two rows) and the drain: once a row's last result is written, its
     pixels go out one per clock, each checked against its right pixel's disparity (the banks' minimum)."""
     rw = 1 + db + 16
-    mem = [Signal(intbv(0)[rw:]) for _ in range(2 << xw)]
+    rows_norw = [Signal(intbv(0)[rw:]) for _ in range(2 << xw)]
     wa = Signal(intbv(0)[xw + 1:])
     wd = Signal(intbv(0)[rw:])
     dv = Signal(bool(0))
@@ -1367,8 +1480,8 @@ def drain(clk, clr, tok, go, code, dl, uv, x, y, drain_addr, drain_q, lr_check, 
     @always(clk.posedge)
     def row_ram():
         if go:
-            mem[wa].next = wd
-        q.next = mem[ra]
+            rows_norw[wa].next = wd
+        q.next = rows_norw[ra]
         qr.next = q
 
     @always(clk.posedge)
@@ -1406,34 +1519,33 @@ def drain(clk, clr, tok, go, code, dl, uv, x, y, drain_addr, drain_q, lr_check, 
     insts.append(delay(clk, dx, x2, clocks=2))
     row2 = Signal(bool(0))
     insts.append(delay_clr(clk, clr, drow, row2, clocks=2))
-    xr2 = Signal(intbv(0, min=0, max=width))
-    d2 = Signal(intbv(0, min=0, max=1 << db))
+    xr3 = Signal(intbv(0, min=0, max=width))
+    row3 = Signal(bool(0))
 
-    @always_comb
+    @always(clk.posedge)
     def right_pixel():
-        d2.next = qr[16 + db:16]
+        # the right pixel x - dL, registered before it addresses the banks
+        row3.next = row2
         if x2 >= qr[16 + db:16]:
-            xr2.next = x2 - qr[16 + db:16]
+            xr3.next = x2 - qr[16 + db:16]
         else:
-            xr2.next = 0
+            xr3.next = 0
 
     insts.append(right_pixel)
     for k in range(pu):
-        insts.append(bank_addr(row2, xr2, drain_addr[k], xw=xw))
-    # drain_q holds at stage 3; registered once more (stage 4), masked and reduced
-    tl = tree_latency(pu)
-    xr4 = _like(xr2)
-    insts.append(delay(clk, xr2, xr4, clocks=2))
+        insts.append(bank_addr(row3, xr3, drain_addr[k], xw=xw))
+    # drain_q holds at stage 4; masked into a register (stage 5), then reduced one level per clock
+    tl = tree_latency(pu, 1)
+    xr4 = _like(xr3)
+    insts.append(delay(clk, xr3, xr4, clocks=1))
     keys = []
     for k in range(pu):
-        qk = _like(drain_q[k])
-        insts.append(delay(clk, drain_q[k], qk, clocks=1))
         mk = Signal(intbv(0)[kb + 1:])
-        insts.append(bank_key(qk, xr4, mk, k=k, width=width))
+        insts.append(bank_key(clk, drain_q[k], xr4, mk, k=k, width=width))
         keys.append(mk)
     best = Signal(intbv(0)[kb + 1:])
-    insts.append(min_tree(clk, keys, best))
-    n = 2 + tl
+    insts.append(min_tree(clk, keys, best, per_stage=1))
+    n = 3 + tl
     vq = Signal(bool(0))
     insts.append(delay_clr(clk, clr, v2, vq, clocks=n))
     eolq = Signal(bool(0))
@@ -1487,16 +1599,15 @@ def bank_addr(row, xr, addr, *, xw: int):
 
 
 @block
-def bank_key(q, xr, key, *, k: int, width: int):
+def bank_key(clk, q, xr, key, *, k: int, width: int):
     """A bank's minimum for right pixel xr, or all ones where no disparity of the bank reached it
-    (xr + k beyond the row: the entry is of an older row)."""
+    (xr + k beyond the row: the entry is of an older row), registered."""
     none = (1 << len(key)) - 1
+    last = width - 1 - k                       # xr + k <= width - 1, as a comparison with a constant
 
-    @always_comb
+    @always(clk.posedge)
     def logic():
-        t = intbv(0, min=0, max=xr.max + k + 1)
-        t[:] = xr + k
-        if t <= width - 1:
+        if xr <= last:
             key.next = q
         else:
             key.next = none

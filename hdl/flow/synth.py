@@ -110,9 +110,8 @@ VARIANTS = [
     ("stereo_frontend stream", "stereo_frontend", dict(rectify="stream")),
     ("stereo_frontend sdram stream", "stereo_frontend", dict(memory="sdram", rectify="stream")),
     ("census 7x7", "census", dict(window=7)),
-    # Issue 28: the 2-path SGM (one previous-row ring instead of three) and 8 disparities per clock
+    # Issue 28: the 2-path SGM (one previous-row ring instead of three)
     ("sgm 2 paths", "sgm", dict(paths=2)),
-    ("sgm pu=8", "sgm", dict(pu=8)),
 ]
 #: Clock ports a variant leaves unused (no goal row for them): the single-clock front end has no Harris clock.
 UNUSED_CLOCKS = {"stereo_frontend single-clock": ("hclk",)}
@@ -123,6 +122,9 @@ ECP5 = ("--25k", "--package", "CABGA381", "--speed", "6")
 #: ports) are placed on the largest package instead, same speed grade: the figure is then for that device.
 ECP5_WIDE = ("--85k", "--package", "CABGA756", "--speed", "6")
 ECP5_IOS = 197
+#: Block RAMs of the 25k (DP16KD): a block that needs more (the dense SGM core's path-cost rings) is placed on
+#: the LFE5U-85F too (208), the device the dense option targets (docs/dense.md).
+ECP5_BRAMS = 56
 #: nextpnr's timing weight in its analytic placer (default 10): 40 pulls the cells of critical paths closer
 #: together; on the single-clock front end's netlist it raised the slowest of seeds 1, 2, 4 from 95.4 to
 #: 105.0 MHz at no cost elsewhere (issue 23: the front end's paths are two thirds routing).
@@ -134,6 +136,12 @@ NEXTPNR_OPTS = ("--placer-heap-timingweight", "40")
 #: its cell says "out of context".
 ECP5_WIDE_IOS = 365
 ECP5_OOC = ("--out-of-context",)
+
+
+def _block_rams(netlist_json: Path, top: str) -> int:
+    """DP16KD cells of ``top`` in a Yosys JSON netlist of synth_ecp5."""
+    mod = json.loads(Path(netlist_json).read_text())["modules"][top]
+    return sum(1 for c in mod["cells"].values() if c["type"] == "DP16KD")
 
 
 def _port_bits(netlist_json: Path, top: str) -> int:
@@ -326,7 +334,9 @@ def place(job: dict, *, freq: float = 100.0, seed: int = 1, tag: str = "") -> di
     (d / "ecp5.lpf").write_text("".join(f'FREQUENCY PORT "{c}" {freq:.1f} MHz;\n' for c in clocks))
     t0 = time.perf_counter()
     bits = _port_bits(d / "ecp5.json", job["block"])
-    device = ECP5 if bits <= ECP5_IOS else ECP5_WIDE if bits <= ECP5_WIDE_IOS else ECP5 + ECP5_OOC
+    brams = _block_rams(d / "ecp5.json", job["block"])
+    device = (ECP5 if bits <= ECP5_IOS and brams <= ECP5_BRAMS else ECP5_WIDE if bits <= ECP5_WIDE_IOS
+              else ECP5 + ECP5_OOC)
     cmd = nextpnr_command() + list(device) + list(NEXTPNR_OPTS) + [
         "--json", "ecp5.json", "--lpf", "ecp5.lpf", "--lpf-allow-unconstrained", "--timing-allow-fail",
         "--seed", str(seed), "--report", f"pnr_report{tag}.json", "--log", f"nextpnr{tag}.log", "-q"]
@@ -480,7 +490,8 @@ def table(results: list[dict]) -> str:
         ooc = [f"{r.get('label', r['block'])} ({r['out_of_context']})" for r in results if r.get("out_of_context")]
         if wide:
             lines.append(f"Placed on the LFE5U-85F ({' '.join(ECP5_WIDE)}) because they have more port bits than "
-                         f"the 25k's package has I/O ({ECP5_IOS}): {', '.join(wide)}.")
+                         f"the 25k's package has I/O ({ECP5_IOS}) or need more block RAM than its {ECP5_BRAMS} "
+                         f"DP16KD: {', '.join(wide)}.")
         if ooc:
             lines.append("Placed out of context (`--out-of-context`: no I/O buffers, the ports stay internal nets, "
                          "as when the block sits inside a design; clocks on general routing): " + ", ".join(ooc) + ".")

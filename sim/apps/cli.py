@@ -152,7 +152,7 @@ def register(sub: Any) -> None:
     """Add the simulation commands (and ``rectifier --vhdl``)."""
     if "rectifier" in sub.choices:
         _wrap_rectifier(sub.choices["rectifier"])
-    p = sub.add_parser("sim", help="run generated VHDL in GHDL on your data (rectify, harris, system)",
+    p = sub.add_parser("sim", help="run generated VHDL in GHDL on your data (rectify, harris, system, dense)",
                        description="Run the generated hardware in GHDL with cocotb.")
     ss = p.add_subparsers(dest="sim_command", metavar="SIMCOMMAND", required=True, parser_class=type(p))
     add_rectify(ss)
@@ -162,3 +162,6 @@ def register(sub: Any) -> None:
     from eyestereo.sim.apps.cli_system import add_system
 
     add_system(ss)
+    from eyestereo.sim.apps.cli_dense import add_dense
+
+    add_dense(ss)

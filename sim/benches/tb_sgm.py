@@ -6,7 +6,8 @@ go in as a stereo stream at a given pixel rate (``pixel_clocks``: the average cl
 with random idle gaps) after an optional partial frame cut by a reset token, frames back to back. Checked:
 each output frame equals the model's codes on every pixel; no beat has undefined bits; exactly the frames
 (and the token) that went in come out, nothing pending or extra; ``overrun`` stays low (or, with
-``expect_overrun``, goes high and stays high). Reported: the clocks from a row's last input pixel to its first
+``expect_overrun``, goes high and stays high). ``save``: a .npy path for the output codes (frames x height x
+width, int64; undefined bits as -1). Reported: the clocks from a row's last input pixel to its first
 output and the output's beats per row.
 """
 
@@ -15,6 +16,7 @@ import numpy as np
 from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, RisingEdge
 
+from eyestereo.hdl.dense.dense_stereo import fifo_depth
 from eyestereo.hdl.dense.sgm import spacing
 from eyestereo.sim.lib.bench import grey_frame as stimulus
 from eyestereo.sim.lib.bench import load_config, write_report
@@ -104,7 +106,8 @@ async def sgm_frames(dut):
     # the last row: its pixels still in the FIFO, then the pipeline, then the drain
     sp = spacing(tb.p["disparities"], tb.p["pu"])
     # (the chain: the census's and the median's last lines first)
-    await ClockCycles(dut.clk, tb.p["fifo"] * sp + 4 * sp + 3 * w + 200 + (8 * w + 100) * tb.chain)
+    fifo = tb.p["fifo"] or fifo_depth(tb.p["window"], w)
+    await ClockCycles(dut.clk, fifo * sp + 4 * sp + 3 * w + 200 + (8 * w + 100) * tb.chain)
 
     mon = tb.monitor
     assert not mon.undefined, f"undefined outputs: {mon.undefined[:4]}"
@@ -131,6 +134,9 @@ async def sgm_frames(dut):
         asm.push(b[1], bool(b[2]), bool(b[3]))
     assert len(asm.frames) == len(pairs), f"{len(asm.frames)} frames out, {len(pairs)} in"
     assert asm.pixels_pending == 0, f"{asm.pixels_pending} pixels of a frame pending"
+    if cfg.get("save"):
+        # the codes as they came out (for a command that shows them), before the comparison can fail
+        np.save(cfg["save"], np.stack([asm.frames[f] for f in range(len(pairs))]).astype(np.int64))
     compared = valid = 0
     for f, (left, right) in enumerate(pairs):
         exp = tb.expected(left, right)
@@ -152,5 +158,7 @@ async def sgm_frames(dut):
             last_in = sent[start + 2 * (y * w + w - 1) + 1]
             lat.append(rows_first[f * h + y] - last_in)
     assert min(lat) > 0, f"a row came out before its last pixel went in ({min(lat)} clocks)"
+    pix = [b for b in mon.beats if not (b[3] and not b[2])]
     write_report(cfg, dict(frames=len(pairs), pixels_compared=compared, valid_codes=valid,
-                           row_latency_min=min(lat), row_latency_max=max(lat), spacing=sp))
+                           row_latency_min=min(lat), row_latency_max=max(lat), spacing=sp,
+                           first_in=sent[starts[0]], last_in=sent[-1], first_out=pix[0][0], last_out=pix[-1][0]))

@@ -20,7 +20,7 @@ TSUKUBA = Path("/work/shared/data/middlebury/tsukuba")
 REAL = [f"image:{TSUKUBA / 'im3.png'}", f"image:{TSUKUBA / 'im4.png'}"]
 SIMS = ["ghdl", pytest.param("icarus", marks=pytest.mark.othersims),
         pytest.param("verilator", marks=pytest.mark.othersims)]
-HW = dict(window=5, disparities=16, pu=4, paths=4, path_bits=7, sum_shift=1, frac_bits=4, fifo=64)
+HW = dict(window=5, disparities=16, pu=4, paths=4, path_bits=7, sum_shift=1, frac_bits=4, fifo=None)
 
 
 @pytest.mark.sim

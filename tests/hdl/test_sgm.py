@@ -111,7 +111,7 @@ def test_sgm_ports_refused():
 def test_sgm_spacing():
     """D / PU groups plus the left path's loop, at least SPACING_MIN."""
     assert (tree_latency(1), tree_latency(4), tree_latency(8), tree_latency(16)) == (1, 1, 2, 2)
-    assert spacing(64, 4) == 18 and spacing(64, 8) == 11 and spacing(16, 4) == SPACING_MIN == 8
+    assert spacing(64, 4) == 18 and spacing(64, 8) == 11 and spacing(16, 4) == SPACING_MIN == 9
     assert spacing(128, 4) == 34
 
 
