@@ -19,6 +19,7 @@ rejected); 1 otherwise; 2 when SymbiYosys or an SMT solver is missing.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import re
 import shutil
@@ -594,6 +595,9 @@ smtbmc {job.engine_opts + " " if job.engine_opts else ""}{solver}
 """
 
 
+_CONVERTED: dict[tuple[str, str], tuple[str, str]] = {}
+
+
 def prepare(job: Job, solver: str, mutant: tuple[str, str, str] | None = None, tag: str = "") -> Path:
     """Convert the block, include the properties, apply the mutant; the job directory."""
     d = BUILD / (job.name + tag)
@@ -601,11 +605,18 @@ def prepare(job: Job, solver: str, mutant: tuple[str, str, str] | None = None, t
         shutil.rmtree(d)
     src = d / "src"
     src.mkdir(parents=True)
-    if job.block in DIRECT:
-        vfile = DIRECT[job.block](src, **job.params)
+    # one conversion per configuration in a run: a job's mutants and the jobs sharing a block reuse its text
+    key = (job.block, json.dumps(job.params, sort_keys=True, default=repr))
+    if key in _CONVERTED:
+        name, text = _CONVERTED[key]
+        vfile = src / name
     else:
-        vfile = _convert()(job.block, src, hdl="Verilog", **job.params)[0]
-    text = vfile.read_text()
+        if job.block in DIRECT:
+            vfile = DIRECT[job.block](src, **job.params)
+        else:
+            vfile = _convert()(job.block, src, hdl="Verilog", **job.params)[0]
+        text = vfile.read_text()
+        _CONVERTED[key] = (vfile.name, text)
     if mutant is not None:
         what, old, new = mutant
         if text.count(old) != 1:

@@ -9,8 +9,35 @@ def pytest_collection_modifyitems(config, items):
         if len(keep) != len(items):
             config.hook.pytest_deselected(items=[it for it in items if it.get_closest_marker("othersims")])
             items[:] = keep
-    # The GHDL benches are the slow part: start them first so the 2 workers finish together.
-    items.sort(key=lambda it: 0 if (it.get_closest_marker("sim") or it.get_closest_marker("othersims")) else 1)
+    # Longest first, so that the workers finish together: each test's recorded time (tests/durations.json, a
+    # suite run's --durations), else a guess by kind (a bench a few seconds, the rest little).
+    dur = _durations()
+
+    def cost(it):
+        if it.nodeid in dur:
+            return dur[it.nodeid]
+        return 3.0 if (it.get_closest_marker("sim") or it.get_closest_marker("othersims")) else 0.1
+
+    items.sort(key=cost, reverse=True)
+    # pytest-xdist's worksteal hands each of the N workers a contiguous 1/N of the list and lets an idle one take
+    # the last half of another's queue: dealt round-robin, every worker's share runs longest first and what is
+    # stolen at the end is short.
+    n = _workers(config)
+    if n > 1:
+        items[:] = [it for k in range(n) for it in items[k::n]]
+
+
+def _durations() -> dict:
+    import json
+    from pathlib import Path
+
+    f = Path(__file__).resolve().parent / "durations.json"
+    return json.loads(f.read_text()) if f.is_file() else {}
+
+
+def _workers(config) -> int:
+    n = getattr(config.option, "numprocesses", None)
+    return n if isinstance(n, int) and n > 0 else 1
 
 
 @pytest.fixture

@@ -37,4 +37,9 @@ K_DEFAULT = 0.04
 K_CODE_DEFAULT = 10
 
 __all__ = ["FRAME_WIDTH", "FRAME_HEIGHT", "FRAME_MIN", "FRAME_MAX", "THRESHOLD_BLOCKS", "NMS_SIZES",
-           "NMS_DEFAULT", "SHARE_FACTORS", "K_DEFAULT", "K_CODE_DEFAULT"]
+           "NMS_DEFAULT", "SHARE_FACTORS", "K_DEFAULT", "K_CODE_DEFAULT", "DENSE_DEFAULTS"]
+
+#: The dense chain's defaults (tuned on Tsukuba, Venus and Motorcycle at 352 x 288, docs/dense.md): the model's
+#: (``eyestereo.tools.models.dense_stereo.DEFAULTS``) and the DENSE register's reset values.
+DENSE_DEFAULTS = dict(window=5, disparities=64, paths=4, p1=10, p2=30, uniqueness=10, lr_check=True, subpixel=True,
+                      median=True)

@@ -225,6 +225,26 @@ class HostDriver:
         (:meth:`~eyestereo.tools.regmap.Register.check_words`)."""
         return [await self.read("SRAM", i) for i in self.regmap["SRAM"].check_words(word, count)]
 
+    async def take_disparity(self, amap, *, timeout_clocks: int = 10_000_000, poll_clocks: int = 50) -> list[int]:
+        """The dense option's newest disparity map: take it (CTRL.disp_want until STATUS.disp_held), read its
+        ``amap.width x amap.height`` codes from the buffer held (``amap``: the front end's
+        :class:`~eyestereo.tools.models.sram_arbiter.AddressMap` with ``dense=True``), give it back
+        (CMD.disp_release); the codes row by row (1/16 px, 0xFFFF where none). TimeoutError when no map comes
+        within ``timeout_clocks`` (the option off, or the system stopped)."""
+        await self.set(disp_want=1)
+        waited = 0
+        while not (st := await self.status())["disp_held"]:
+            if waited >= timeout_clocks:
+                await self.set(disp_want=0)
+                raise TimeoutError(f"no disparity map within {timeout_clocks} clocks (is the dense option built? "
+                                   f"DENSE_STATUS.disp_frames = {st['disp_frames']})")
+            await self.bus.wait(poll_clocks)
+            waited += poll_clocks
+        await self.set(disp_want=0)
+        codes = await self.read_sram_words(amap.disparity(st["disp_buf"]), amap.width * amap.height)
+        await self.pulse("disp_release")
+        return codes
+
     async def write_sram_words(self, word: int, values) -> None:
         """SRAM words ``values`` from word address ``word`` on. The range must lie in the SRAM window and
         every value be an integer 0..65535 (16-bit words); both are checked before the first write, a

@@ -35,7 +35,7 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from eyestereo.tools.constants import FRAME_MAX, FRAME_MIN, K_CODE_DEFAULT
+from eyestereo.tools.constants import DENSE_DEFAULTS, FRAME_MAX, FRAME_MIN, K_CODE_DEFAULT
 from eyestereo.tools.packed import lookup
 
 __all__ = ["Field", "Register", "RegisterMap", "REGISTERS", "REGMAP", "KINDS", "OKAY", "SLVERR", "K_BITS",
@@ -293,6 +293,10 @@ def _f(name, lsb, width, doc, **kw) -> Field:
     return Field(name, lsb, width, doc, **kw)
 
 
+_DISP = "disparity_writer (stereo_frontend's dense option)"
+_DENSE = "dense_stereo's port of the same name (stereo_frontend's dense option)"
+
+
 def _ctl(name, lsb, doc, width=1) -> Field:
     """A field wired to the arbiter's FrameControl member of the same name."""
     return Field(name, lsb, width, doc, connect=FRAME_CONTROL + name)
@@ -311,13 +315,15 @@ REGISTERS: tuple[Register, ...] = (
                  values=((0, "single-shot"), (1, "continuous")), connect=_SEQ),
               _ctl("rect_want", 8, "the host takes the newest rectified pair whenever it holds none "
                    "(FrameControl.rect_want)"),
-              _ctl("feat_want", 9, "the same for the feature lists (FrameControl.feat_want)"))),
+              _ctl("feat_want", 9, "the same for the feature lists (FrameControl.feat_want)"),
+              _f("disp_want", 10, 1, "the same for the disparity maps (dense option)", connect=_DISP))),
     Register("CMD", 0x00C, "pulse", "commands (write 1 to act; reads 0)",
              (_f("start", 0, 1, "start: one stereo frame (single-shot) or frames until stop (continuous)",
                 connect=_SEQ),
               _f("stop", 1, 1, "stop after the frame in progress", connect=_SEQ),
               _ctl("rect_release", 8, "the host has read the rectified pair it holds (FrameControl.rect_release)"),
-              _ctl("feat_release", 9, "the host has read the feature lists it holds (FrameControl.feat_release)"))),
+              _ctl("feat_release", 9, "the host has read the feature lists it holds (FrameControl.feat_release)"),
+              _f("disp_release", 10, 1, "the host has read the disparity map it holds (dense option)", connect=_DISP))),
     Register("STATUS", 0x010, "status", "state of the system and of the frame buffers",
              (_f("busy", 0, 1, "a start is being served (single-shot: until its frame's lists are written)",
                 connect=_SEQ),
@@ -325,8 +331,11 @@ REGISTERS: tuple[Register, ...] = (
                    "FrameControl.avail)", width=4),
               _ctl("rect_held", 8, "the host holds a rectified pair (FrameControl.rect_held)"),
               _ctl("feat_held", 9, "the host holds the feature lists (FrameControl.feat_held)"),
+              _f("disp_held", 10, 1, "the host holds a disparity map (dense option)", connect=_DISP),
+              _f("disp_avail", 11, 1, "a complete disparity map waits (dense option)", connect=_DISP),
               _ctl("rect_buf", 12, "the rectified buffer held (0/1: its SRAM address, AddressMap.rectified)"),
-              _ctl("feat_buf", 13, "the feature-list buffer held (AddressMap.features)"))),
+              _ctl("feat_buf", 13, "the feature-list buffer held (AddressMap.features)"),
+              _f("disp_buf", 14, 1, "the disparity buffer held (AddressMap.disparity)", connect=_DISP))),
     Register("K_LEFT", 0x014, "rw", "Harris k of the left camera, ufix[8,8] (k = code / 256)",
              (_f("k_left", 0, K_BITS, "k code (reset: 10, k = 0.039)", reset=K_RESET,
                  connect="the left Harris k port, through a word_cdc into the Harris clock"),)),
@@ -352,6 +361,23 @@ REGISTERS: tuple[Register, ...] = (
                  connect=_SEQ + " (counts the lists flagged overflowed in ARB words 20, 21)"))),
     Register("FRAME_CLOCKS", 0x030, "status", "memory clocks the last completed frame took from its start "
              "(frames/s = 100e6 / value)", (_f("frame_clocks", 0, 32, "clocks", connect=_SEQ),)),
+    Register("DENSE", 0x034, "rw", "the dense option's run-time settings (sgm's ports; no effect without the option)",
+             (_f("p1", 0, 8, "SGM penalty P1 for a disparity step of 1 (reset: 10)", reset=DENSE_DEFAULTS["p1"],
+                 connect=_DENSE),
+              _f("p2", 8, 8, "SGM penalty P2 for larger steps (reset: 30)", reset=DENSE_DEFAULTS["p2"],
+                 connect=_DENSE),
+              _f("uniqueness", 16, 7, "uniqueness margin in percent (reset: 10)",
+                 reset=DENSE_DEFAULTS["uniqueness"], connect=_DENSE),
+              _f("lr_check", 24, 1, "left-right consistency check on (reset: 1)",
+                 reset=int(DENSE_DEFAULTS["lr_check"]), connect=_DENSE),
+              _f("subpixel", 25, 1, "sub-pixel refinement on (reset: 1)", reset=int(DENSE_DEFAULTS["subpixel"]),
+                 connect=_DENSE))),
+    Register("DENSE_STATUS", 0x038, "status", "the dense option's state (reads 0 without the option)",
+             (_f("disp_frames", 0, 16, "disparity maps completed since reset (wraps)", connect=_DISP),
+              _f("dense_overrun", 16, 1, "the sgm input FIFO lost a pixel since reset (sticky; the front end paces "
+                 "the rectifier so that it should never be set)", connect=_DENSE),
+              _f("disp_lost", 17, 1, "a disparity code found the writer's FIFO full (sticky: the memory did not keep "
+                 "up)", connect=_DISP))),
     Register("THR_LEFT", 0x100, "array", "pre-threshold of each 4x4 block of the left image, index by*4 + bx "
              "(20-bit cornerness code; 0 after reset)",
              (_f("thr_left", 0, THRESHOLD_BITS, "threshold code",

@@ -110,8 +110,9 @@ VARIANTS = [
     ("stereo_frontend stream", "stereo_frontend", dict(rectify="stream")),
     ("stereo_frontend sdram stream", "stereo_frontend", dict(memory="sdram", rectify="stream")),
     ("census 7x7", "census", dict(window=7)),
-    # Issue 28: the 2-path SGM (one previous-row ring instead of three)
+    # Issue 28: the 2-path SGM (one previous-row ring instead of three); the front end with the dense option
     ("sgm 2 paths", "sgm", dict(paths=2)),
+    ("stereo_frontend dense", "stereo_frontend", dict(dense=True)),
 ]
 #: Clock ports a variant leaves unused (no goal row for them): the single-clock front end has no Harris clock.
 UNUSED_CLOCKS = {"stereo_frontend single-clock": ("hclk",)}

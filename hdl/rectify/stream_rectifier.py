@@ -10,6 +10,7 @@ from eyestereo.hdl.interfaces.queue import check_queue
 from eyestereo.hdl.rectify.calibration import calibration_param
 from eyestereo.hdl.rectify.fetch_interpolate import DEFAULT_DEPTH
 from eyestereo.hdl.rectify.line_cache import line_cache
+from eyestereo.hdl.rectify.fetch_gate import fetch_gate
 from eyestereo.hdl.rectify.rectifier import rectifier
 from eyestereo.tools.camera import WORD as CAMERA_WORD
 from eyestereo.tools.models import line_cache as cache_model
@@ -19,7 +20,8 @@ __all__ = ["stream_rectifier"]
 
 
 @block
-def stream_rectifier(clk, rst, cam0, cam1, source, start, arm, begun, busy, overrun, coef=None, *, quantizers=None,
+def stream_rectifier(clk, rst, cam0, cam1, source, start, arm, begun, busy, overrun, coef=None, hold=None, *,
+                     quantizers=None,
                      frac: int | None = unit_model.DEFAULT_FRAC, lines: int | None = None,
                      depth: int = DEFAULT_DEPTH):
     """Rectify the cameras' frames as they arrive: no frame store, no memory reads (``rectify="stream"``).
@@ -56,6 +58,9 @@ def stream_rectifier(clk, rst, cam0, cam1, source, start, arm, begun, busy, over
         overrun: out, 1 bit: one-clock pulse: the frame being rectified read a line the cameras had already
             overwritten, or a camera began its next frame first: the frame is not the cameras' (drop it).
         coef: optional :class:`~eyestereo.hdl.rectify.poly_unit.CoefPort`, as for the rectifier.
+        hold: optional in, 1 bit: while high the rectifier makes no new fetch
+            (:func:`~eyestereo.hdl.rectify.fetch_gate.fetch_gate`; the front end's dense option paces it so). A held
+            rectifier falls behind the cameras: held too long, its lines are overwritten (``overrun``).
 
     Parameters:
         quantizers, frac: the calibration and coordinate fraction bits, as for the rectifier; the cameras'
@@ -95,7 +100,13 @@ def stream_rectifier(clk, rst, cam0, cam1, source, start, arm, begun, busy, over
     go, r_busy, c_begun = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
     cache = line_cache(clk, rst, cam0, cam1, fetch, go, r_busy, arm, c_begun, overrun, width=cal.source_width,
                        height=cal.source_height, lines=lines)
-    rect = rectifier(clk, rst, go, fetch, source, r_busy, coef, quantizers=cal, frac=frac, depth=depth)
+    rfetch = fetch
+    gate = []
+    if hold is not None:
+        check_signal("hold", hold, width=1)
+        rfetch = FetchPort(cal.source_width, cal.source_height)
+        gate = [fetch_gate(clk, rst, rfetch, fetch, hold)]
+    rect = rectifier(clk, rst, go, rfetch, source, r_busy, coef, quantizers=cal, frac=frac, depth=depth)
 
     @always_comb
     def control():
@@ -104,4 +115,4 @@ def stream_rectifier(clk, rst, cam0, cam1, source, start, arm, begun, busy, over
         busy.next = r_busy
         begun.next = c_begun  # an output port is not read (VHDL-93)
 
-    return cache, rect, control
+    return cache, rect, control, gate

@@ -22,6 +22,12 @@ from eyestereo.hdl.rectify.calibration import calibration_param
 from eyestereo.hdl.interfaces.queue import QueuePort
 from eyestereo.hdl.rectify.rectifier import rectifier
 from eyestereo.hdl.rectify.stream_rectifier import stream_rectifier
+from eyestereo.hdl.rectify.fetch_gate import fetch_gate
+from eyestereo.hdl.dense.dense_stereo import dense_stereo
+from eyestereo.hdl.dense.sgm import PU_CHOICES
+from eyestereo.hdl.system.disparity_writer import disparity_writer
+from eyestereo.tools.models.sgm import D_RANGE, PATHS
+from eyestereo.tools.models.sram_arbiter import AddressMap
 from eyestereo.hdl.system.register_bank import RegisterPorts, register_bank
 from eyestereo.hdl.interfaces.sram_bus import HostPort, SramPins, StatPort, check_bundle
 from eyestereo.hdl.memory.sram_subsystem import sram_subsystem
@@ -35,11 +41,11 @@ from eyestereo.hdl.streaming.word_cdc import word_cdc
 from eyestereo.tools.models import poly_unit as unit_model
 from eyestereo.tools.models.sram_arbiter import CAMERA_WORD
 from eyestereo.tools.camera import ORDERS
-from eyestereo.tools.constants import NMS_DEFAULT, NMS_SIZES, THRESHOLD_BLOCKS
+from eyestereo.tools.constants import DENSE_DEFAULTS, NMS_DEFAULT, NMS_SIZES, THRESHOLD_BLOCKS
 from eyestereo.tools.regmap import REGMAP
 from eyestereo.tools.sram import KINDS
 
-__all__ = ["stereo_frontend", "BLOCKS", "CAM_DEPTH", "MEMORY", "RECTIFY", "THR_BITS"]
+__all__ = ["stereo_frontend", "dense_option", "dense_fifo", "BLOCKS", "CAM_DEPTH", "MEMORY", "RECTIFY", "THR_BITS"]
 
 #: The rectification choices: from the frame store (the thesis's) or from an on-chip line cache.
 RECTIFY = ("fetch", "stream")
@@ -64,7 +70,9 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
                     max_features: int = 1023, feature_words: int = 2048, cam_depth: int = CAM_DEPTH,
                     kind: str = "nobl", read_latency: int = 2, order: str = "YUYV", rect_depth: int = DEFAULT_DEPTH,
                     single_clock: bool = False, rectify: str = "fetch", cache_lines: int | None = None,
-                    memory: str = "sram", sdram_part: str = ULX3S):
+                    memory: str = "sram", sdram_part: str = ULX3S, dense: bool = False,
+                    disparities: int = DENSE_DEFAULTS["disparities"], pu: int = 4,
+                    paths: int = DENSE_DEFAULTS["paths"]):
     """The complete stereo front end of the thesis's Fig. 7.2, with the processor's register bus.
 
     Data flow: each camera bus -> :func:`~eyestereo.hdl.camera.camera_interface.camera_pair` (converter and
@@ -133,11 +141,26 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
             by :func:`~eyestereo.hdl.memory.sdram_subsystem.sdram_subsystem`): the same masters, address map,
             register map and host driver. Pair it with ``rectify="stream"`` (the 2x2 fetches jump rows).
         sdram_part: the SDRAM part (:mod:`eyestereo.tools.sdram`'s name or spec), for ``memory="sdram"``.
+        dense: False (default) or True: the disparity map of every rectified pair (:func:`dense_option`:
+            :func:`~eyestereo.hdl.dense.dense_stereo.dense_stereo` on the rectified stream in the memory clock,
+            census 5 x 5, semi-global matching, the median) into two disparity buffers
+            (:class:`~eyestereo.tools.models.sram_arbiter.AddressMap`'s ``dense``), written through the host port by
+            :func:`~eyestereo.hdl.system.disparity_writer.disparity_writer`; the host takes them like the rectified
+            pairs (CTRL.disp_want, CMD.disp_release, STATUS.disp_held/disp_buf) and sets P1, P2, the uniqueness and
+            the checks in DENSE. The dense core paces the rectifier (its fetches wait while the core is full), so
+            a rectified pair takes ``width x height x`` :func:`~eyestereo.hdl.dense.sgm.spacing` clocks (D 64,
+            PU 4, CIF: 1.82 M, 18.2 ms at 100 MHz: within the cameras' 20 ms with ``rectify="fetch"``). With
+            ``rectify="stream"`` the rows must also keep up with the cameras' lines (the line cache): a row's
+            ``width x spacing`` clocks within a camera line period (CIF at 50 frames/s: 5,050 clocks; PU 8 takes
+            3,872, PU 4 6,336: too slow).
+        disparities, pu, paths: the dense core's D (16..128, below ``width``), disparities per clock and
+            aggregation paths (2 or 4), as :func:`~eyestereo.hdl.dense.sgm.sgm`'s.
 
     Latency: a frame's features are complete a few lines (Harris's lead, :func:`harris_stereo.latency`)
     after the rectifier's last beat; the sequencer's ``frame_clocks`` measures the whole.
 
-    Resources: the sum of the blocks (docs/system.md: Yosys, Spartan-3E 500).
+    Resources: the sum of the blocks (docs/system.md: Yosys, Spartan-3E 500); with ``dense``, the dense core's
+    (docs/dense.md) and the writer's block RAM: only the ECP5-85F class holds it.
     """
     check_clock(clk)
     check_reset(rst)
@@ -178,6 +201,21 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     if cache_lines is not None and not stream:
         raise block_error("parameter cache_lines is for rectify='stream' (the line cache)")
 
+    dense = check_bool("dense", dense)
+    if dense:
+        disparities = check_int("disparities", disparities, *D_RANGE)
+        pu = check_choice("pu", pu, PU_CHOICES)
+        paths = check_choice("paths", paths, PATHS)
+        if disparities % pu or disparities // pu < 2:
+            raise block_error(f"parameters disparities={disparities}, pu={pu}: pu must divide the disparities into "
+                              "groups of at least two")
+        if width <= disparities:
+            raise block_error(f"parameter disparities={disparities}: the {width}-pixel rows must be wider")
+    try:
+        amap = AddressMap(width, height, feature_words, cameras=not stream, dense=dense)
+    except ValueError as exc:
+        raise block_error(f"parameter quantizers: {exc}") from None
+
     insts = []
     # ---- cameras into the memory clock ---------------------------------------------------------
     fifo0, fifo1 = QueuePort(CAMERA_WORD), QueuePort(CAMERA_WORD)
@@ -199,6 +237,8 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     host, stat, ctl = HostPort(), StatPort(), FrameControl()
     fcount = StatPort(5, 16)
     regs = RegisterPorts()
+    # dense: the disparity writer shares the memory's host port with the register bank
+    bank_host = HostPort() if dense else host
     mem_ready = Signal(bool(memory == "sram"))  # the SRAM: always (undriven: a constant); the SDRAM: after power-up
     if memory == "sram":
         insts.append(sram_subsystem(clk, rst, m_cam0, m_cam1, fetch, rect, feat, host, ctl, stat, sram, kind=kind,
@@ -208,10 +248,11 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
         insts.append(sdram_subsystem(clk, rst, m_cam0, m_cam1, fetch, rect, feat, host, ctl, stat, sram, mem_ready,
                                      part=sdram_part, width=width, height=height, feature_words=feature_words,
                                      cameras=not stream))
-    insts.append(register_bank(clk, rst, bus, regs, stat, fcount, host, width=width, height=height))
+    insts.append(register_bank(clk, rst, bus, regs, stat, fcount, bank_host, width=width, height=height))
 
     # ---- rectifier and sequencer -----------------------------------------------------------------
     r_start, r_busy = Signal(bool(0)), Signal(bool(0))
+    hold = Signal(bool(0))  # dense: the rectifier waits (the dense core is full)
     top = (1 << 16) - 1
     overrun = Signal(bool(0))
     overruns = Signal(intbv(0)[16:])
@@ -219,8 +260,9 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
         # the sequencer's camera handshake: a pair is "held" when both cameras have begun a frame
         sctl = FrameControl()
         s_arm, s_begun = Signal(bool(0)), Signal(bool(0))
-        insts.append(stream_rectifier(clk, rst, cam0, cam1, rect, r_start, s_arm, s_begun, r_busy, overrun,
-                                      quantizers=cal, frac=frac, lines=cache_lines, depth=rect_depth))
+        insts.append(stream_rectifier(clk, rst, cam0, cam1, rect, r_start, s_arm, s_begun, r_busy, overrun, None,
+                                      hold if dense else None, quantizers=cal, frac=frac, lines=cache_lines,
+                                      depth=rect_depth))
 
         @always_comb
         def stream_handshake():
@@ -236,7 +278,11 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
         insts += [stream_handshake, overrun_count]
     else:
         sctl = ctl
-        insts.append(rectifier(clk, rst, r_start, fetch, rect, r_busy, quantizers=cal, frac=frac, depth=rect_depth))
+        r_fetch = fetch
+        if dense:
+            r_fetch = FetchPort(width, height)
+            insts.append(fetch_gate(clk, rst, r_fetch, fetch, hold))
+        insts.append(rectifier(clk, rst, r_start, r_fetch, rect, r_busy, quantizers=cal, frac=frac, depth=rect_depth))
     l_done, l_ovf = Signal(bool(0)), Signal(bool(0))
     insts.append(frontend_sequencer(clk, rst, regs.mode, regs.continuous, regs.start, regs.stop, sctl, r_start,
                                     r_busy, l_done, l_ovf, regs.busy, regs.frames, regs.frame_clocks,
@@ -336,4 +382,69 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
         regs.harris_overflows.next = h_dropped_m + f_dropped
 
     insts += [count_port, count_regs, wiring]
+    if dense:
+        insts.append(dense_option(clk, rst, rect, hold, regs, bank_host, host, amap=amap, disparities=disparities,
+                                  pu=pu, paths=paths))
+    return insts
+
+
+def dense_fifo(width: int, window: int = DENSE_DEFAULTS["window"]) -> int:
+    """The dense option's sgm FIFO: a power of two of at least the pixels the core holds outside it (census's
+    lead of ``window // 2`` rows and pixels, sgm's row in work and the row it drains, the median's row) and 128
+    (352 wide: 2048). The pacing keeps the pixels inside the core at the depth less 64, so the FIFO then still
+    holds at least 64: the core never waits for pixels, and the rectifier is never held for good."""
+    r = window // 2
+    return 1 << (r * width + r + 3 * width + 1 + 128 - 1).bit_length()
+
+
+@block
+def dense_option(clk, rst, rect, hold, regs, bank, mem, *, amap: AddressMap, disparities: int, pu: int, paths: int):
+    """The front end's ``dense`` option: the dense core on the rectified stream, its pacing and its writer.
+
+    :func:`~eyestereo.hdl.dense.dense_stereo.dense_stereo` (in the memory clock) takes every rectified pair of
+    ``rect``. ``hold`` (to the rectifier's fetch gate) is high while the pixels inside the core (counted in as
+    right beats and out as codes; a reset token clears the count) reach its FIFO's depth (:func:`dense_fifo`)
+    less 64: every pixel in the FIFO is one of them, so the FIFO cannot overrun (after ``hold`` at most the
+    rectifier's fetches in flight still come), and the count's level leaves the FIFO pixels to work on. The
+    codes go to :func:`~eyestereo.hdl.system.disparity_writer.disparity_writer` (the two buffers of ``amap``),
+    which shares the memory's host port ``mem`` with the register bank's ``bank``. Wired here: DENSE (p1, p2,
+    uniqueness, lr_check, subpixel), DENSE_STATUS (disp_frames, dense_overrun, disp_lost) and the disp_*
+    bits of CTRL, CMD and STATUS.
+
+    Latency: dense_stereo's (census's ``window // 2`` rows, sgm's row, the median's row), then the writer's FIFO.
+
+    Resources: dense_stereo's with the FIFO above, the writer's, a 12-bit counter and a comparator.
+    """
+    width, height = amap.width, amap.height
+    window = DENSE_DEFAULTS["window"]
+    depth = dense_fifo(width, window)
+    limit = depth - 64
+    codes = ImageStream(16)
+    overrun, lost = Signal(bool(0)), Signal(bool(0))
+    inside = Signal(intbv(0, min=0, max=depth + 1))
+    insts = [dense_stereo(clk, rst, rect, codes, regs.p1, regs.p2, regs.uniqueness, regs.lr_check, regs.subpixel,
+                          overrun, window=window, disparities=disparities, pu=pu, paths=paths, fifo=depth,
+                          width=width, height=height),
+             disparity_writer(clk, rst, codes, bank, mem, regs.disp_want, regs.disp_release, regs.disp_held,
+                              regs.disp_avail, regs.disp_buf, regs.disp_frames, lost, base0=amap.disparity(0),
+                              base1=amap.disparity(1), width=width, height=height)]
+
+    @always_seq(clk.posedge, reset=rst)
+    def pacing():
+        pix_in = rect.valid and rect.cam and (rect.eol or not rect.eof)
+        code_out = codes.valid and (codes.eol or not codes.eof)
+        if rect.valid and rect.eof and not rect.eol:
+            inside.next = 0
+        elif pix_in and not code_out:
+            inside.next = inside + 1
+        elif code_out and not pix_in and inside != 0:
+            inside.next = inside - 1
+        hold.next = inside >= limit
+
+    @always_comb
+    def status():
+        regs.dense_overrun.next = overrun
+        regs.disp_lost.next = lost
+
+    insts += [pacing, status]
     return insts

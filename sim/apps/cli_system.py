@@ -11,8 +11,11 @@ host driver reads every frame back over AXI4-Lite and compares it with the numpy
 ``OUT/rectified.png`` (the rectified pair side by side with row lines and the corners), ``OUT/matches.png``
 (the host's feature lists matched by the matching package, coloured by disparity) and
 ``OUT/summary.json``; ``--json FILE`` the same figures (frames, fps per mode, SRAM share per master,
-bit_exact). A one-screen summary on stdout. Small frames keep it to a few minutes on 2 cores (GHDL runs
-the system at a few thousand clocks per second); ``--frames`` is 1..64 per mode.
+bit_exact). ``--dense D``: the front end built with the dense option (D disparities, below the camera
+width): the host also takes every disparity map (compared bit for bit with the dense model of a rectified
+pair) and ``OUT/disparity.png`` shows the last one (summary: ``dense``). A one-screen summary on stdout.
+Small frames keep it to a few minutes on 2 cores (GHDL runs the system at a few thousand clocks per second);
+``--frames`` is 1..64 per mode.
 
 Every input is checked before the build (images, sizes, the simulator, the bench's packages, the output
 places); outputs are written all or nothing (``OUT`` and ``--json`` together), ``OUT`` new, empty or
@@ -31,17 +34,19 @@ from typing import Any
 
 import numpy as np
 
+from eyestereo.sim.apps.cli_dense import disparities_arg, pu_of, write_picture
 from eyestereo.sim.apps.cli_rectify import add_build_dir
 from eyestereo.sim.lib.frontend_runs import CLOCKS, PUBLIC, SHORT_BLANKING, figures
 from eyestereo.tools.cli.common import integer
 from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
+from eyestereo.tools.models.sgm import INVALID
 from eyestereo.tools.models.sram_arbiter import MASTERS
 
 MODES = ("sequential", "overlapped")
 #: Stereo frames the host reads per mode, at most (each costs a camera frame and more of simulation).
 MAX_FRAMES = 64
 #: What the command writes into OUT.
-OWNED = ("rectified.png", "matches.png", "summary.json")
+OWNED = ("rectified.png", "matches.png", "summary.json", "disparity.png")
 #: The camera timing of the command's runs (a short blanking: the small frames go fast).
 TIMING = SHORT_BLANKING
 #: The bench's Python packages beyond the library's own (named in the error when one is missing).
@@ -83,6 +88,9 @@ def add_system(sub: Any) -> None:
     p.add_argument("--modes", type=modes_list, default=list(MODES), help="comma list of modes (default both)")
     p.add_argument("--sim", choices=("ghdl", "icarus", "verilator"), default=None,
                    help="simulator (default: the fastest here: Verilator on MyHDL's Verilog if installed, else GHDL)")
+    p.add_argument("--dense", type=disparities_arg, metavar="D", default=None,
+                   help="build the front end with the dense option, D disparities (below the width): the host also "
+                        "reads the disparity maps (bit for bit against the model); OUT/disparity.png is the last")
     add_build_dir(p)
     p.set_defaults(func=cmd_sim_system)
 
@@ -162,9 +170,12 @@ def check_bench_packages() -> None:
             raise ValueError(f"'sim system' needs the Python package {package}: pip install {package}")
 
 
-def run_mode(mode: str, work: Path, *, size, frames: int, sim: str) -> tuple[str, dict, Path]:
-    """The job (:func:`eyestereo.sim.apps.job.run_jobs`) of one mode's run, in its own folder below ``work``."""
+def run_mode(mode: str, work: Path, *, size, frames: int, sim: str,
+             dense: int | None = None) -> tuple[str, dict, Path]:
+    """The job (:func:`eyestereo.sim.apps.job.run_jobs`) of one mode's run, in its own folder below ``work``;
+    ``dense``: the dense option's D (None: off)."""
     w, h = size
+    extra = {} if dense is None else dict(dense=True, disparities=dense, pu=pu_of(dense))
     folder = work / mode
     folder.mkdir()
     return ("eyestereo.sim.lib.runner:run_bench",
@@ -172,14 +183,14 @@ def run_mode(mode: str, work: Path, *, size, frames: int, sim: str) -> tuple[str
                  config=dict(mode=mode, frames=frames, pair=[str(work / "left.npy"), str(work / "right.npy")],
                              timing=TIMING),
                  name=f"cli_{mode}_{w}x{h}",
-                 params=dict(quantizers=f"rig:{w}x{h}", feature_words=512, max_features=255),
+                 params=dict(quantizers=f"rig:{w}x{h}", feature_words=512, max_features=255, **extra),
                  build_root=folder / "build", log_file=folder / f"{mode}.log", sim=sim,
                  public=PUBLIC if sim == "verilator" else None),
             folder)
 
 
 def simulate(left: np.ndarray, right: np.ndarray, folder: Path, work: Path, *, size=(48, 32), frames: int = 2,
-             modes=MODES, sim: str = "ghdl") -> dict:
+             modes=MODES, sim: str = "ghdl", dense: int | None = None) -> dict:
     """Run the system on an 8-bit grey pair (any size, resized to ``size``) in ``work`` (a run folder of
     :func:`eyestereo.sim.apps.job.run_folder`) and write the pictures and summary.json into ``folder``;
     returns the summary. :class:`eyestereo.sim.apps.job.JobFailed` when a simulation fails."""
@@ -193,7 +204,7 @@ def simulate(left: np.ndarray, right: np.ndarray, folder: Path, work: Path, *, s
     w, h = size
     for name, img in (("left", left), ("right", right)):
         np.save(work / f"{name}.npy", cv2.resize(img, (w, h), interpolation=cv2.INTER_AREA).astype(np.uint8))
-    jobs = [run_mode(m, work, size=size, frames=frames, sim=sim) for m in modes]
+    jobs = [run_mode(m, work, size=size, frames=frames, sim=sim, dense=dense) for m in modes]
     # GHDL: both modes at once (2 cores); a Verilator build already uses both cores: one after the other
     reps = dict(zip(modes, run_jobs(jobs, at_once=1 if sim == "verilator" else 2, what=f"the simulation "
                                     f"({describe(sim)})")))
@@ -209,12 +220,20 @@ def simulate(left: np.ndarray, right: np.ndarray, folder: Path, work: Path, *, s
                    features_last_frame=len(last["features"]), matches_last_frame=matched,
                    bit_exact=all(r["bit_exact"] for r in reps.values()), simulator=describe(sim),
                    clocks=CLOCKS)
+    if dense is not None:
+        codes = np.array(last["disparity"], np.int64)
+        valid = codes != INVALID
+        write_picture(folder / "disparity.png", np.where(valid, codes / 16.0, np.nan), dense)
+        summary["dense"] = dict(disparities=dense, maps_read={m: len(r["frames"]) for m, r in reps.items()},
+                                maps_completed={m: r.get("disp_frames") for m, r in reps.items()},
+                                valid_last_map=round(float(valid.mean()), 4))
     atomic_write_text(folder / "summary.json", json.dumps(summary, indent=2) + "\n")
     return summary
 
 
 def main_system(left: Path, right: Path, output: Path, *, size=(48, 32), frames: int = 2, modes=MODES,
-                sim: str | None = None, json_file: Path | None = None, build_dir: Path | None = None) -> dict:
+                sim: str | None = None, json_file: Path | None = None, build_dir: Path | None = None,
+                dense: int | None = None) -> dict:
     """The command's work for a library caller (``make demo``): check every input, run, write ``output``
     (and ``json_file``) all or nothing; returns the summary. ValueError for bad input or a failed run."""
     from eyestereo.sim.apps.cli_rectify import read_pair
@@ -227,6 +246,8 @@ def main_system(left: Path, right: Path, output: Path, *, size=(48, 32), frames:
         raise ValueError(f"modes must be taken from {', '.join(MODES)}, got {modes}")
     if not 1 <= int(frames) <= MAX_FRAMES:
         raise ValueError(f"frames must be 1..{MAX_FRAMES}, got {frames}")
+    if dense is not None and dense >= size[0]:
+        raise ValueError(f"--dense {dense}: the {size[0]}-pixel rows must be wider than the disparities")
     lg, rg = read_pair(left, right)
     sim = check_simulator(sim or fastest_simulator())
     check_bench_packages()
@@ -235,7 +256,8 @@ def main_system(left: Path, right: Path, output: Path, *, size=(48, 32), frames:
         folder = out.folder(output, OWNED, inputs=[left, right])
         js = out.file(json_file) if json_file is not None else None
         with run_folder("sim-system", build_dir) as work:
-            summary = simulate(lg, rg, folder, work, size=size, frames=int(frames), modes=modes, sim=sim)
+            summary = simulate(lg, rg, folder, work, size=size, frames=int(frames), modes=modes, sim=sim,
+                               dense=dense)
         if js is not None:
             js.write_text(json.dumps(summary, indent=2) + "\n")
     return summary
@@ -244,7 +266,7 @@ def main_system(left: Path, right: Path, output: Path, *, size=(48, 32), frames:
 def cmd_sim_system(args) -> int:
     w, h = args.size
     summary = main_system(args.left, args.right, args.output, size=args.size, frames=args.frames, modes=args.modes,
-                          sim=args.sim, json_file=args.json, build_dir=args.build_dir)
+                          sim=args.sim, json_file=args.json, build_dir=args.build_dir, dense=args.dense)
     print(f"stereo front end, {w}x{h} cameras (18 / 17.9 MHz), memory 100 MHz, Harris 50 MHz "
           f"({summary['simulator']}, simulated time)")
     for m in args.modes:
@@ -255,4 +277,8 @@ def cmd_sim_system(args) -> int:
     print(f"  features in the last frame: {summary['features_last_frame']}, matched {mt['matches']} "
           f"(disparities {mt['disparity']}); bit-exact: {'yes' if summary['bit_exact'] else 'no'}; "
           f"pictures: {args.output}/rectified.png, matches.png")
+    if args.dense is not None:
+        d = summary["dense"]
+        print(f"  dense: D {d['disparities']}, disparity maps read {sum(d['maps_read'].values())} (each bit for bit "
+              f"the model's), {100 * d['valid_last_map']:.1f} % valid in the last; {args.output}/disparity.png")
     return 0

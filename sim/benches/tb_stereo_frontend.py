@@ -20,6 +20,13 @@ violation, the bus checker no fault. A frame without features is accepted (a fla
 configuration with ``require_features`` asks for features in every frame read (in one at least with
 ``adaptive``: the closed loop may drive a frame to none on its way).
 
+With the ``dense`` option (``params["dense"]``) the host also takes each disparity map (``disp_want``), reads it
+from its buffer and releases it; it must equal, bit for bit, the dense model
+(:func:`eyestereo.tools.models.stereo_frontend.disparity`) of one of the rectified pairs (the pair the host read
+in the same round, or a neighbour: the map can lag its pair), with the settings of the DENSE register
+(``dense_settings``, else the reset values); at the end the core's FIFO never overran (``dense_overrun``), the
+writer lost no code (``disp_lost``) and completed at least as many maps as were read.
+
 The scene: ``images`` (:func:`stereo_frames`: ``random:S``, ``shift:S``, ``files:LEFT,RIGHT``) or ``pair``:
 ``[left.npy, right.npy]``, each an (height, width) uint8 array at the camera size, the Y of every frame of
 that camera (:func:`pair_frames`).
@@ -162,8 +169,10 @@ async def frames_bit_exact(dut):
     n_host = cfg.get("frames", 3)
     # sequential: each frame lets a few camera frames pass (arming, read-out): enough for every one
     n_cam = cfg.get("camera_frames", 5 * n_host + 4)
+    dense = bool(cfg["params"].get("dense", False))
     amap = AddressMap(w, h, cfg["params"].get("feature_words", 2048),
-                      cameras=cfg["params"].get("rectify", "fetch") != "stream")
+                      cameras=cfg["params"].get("rectify", "fetch") != "stream", dense=dense)
+    dsets = dense_settings(cfg)
     if cfg.get("pair") is not None:
         if cfg.get("images") is not None:
             raise ValueError("give the scene as images or as pair, not both")
@@ -203,6 +212,8 @@ async def frames_bit_exact(dut):
     await drv.configure(mode=mode, continuous=bool(cfg.get("continuous", mode == "overlapped")), k_left=k,
                         k_right=k, thresholds_left=[thr] * 16, thresholds_right=[thr] * 16)
     assert await drv.read_thresholds("THR_LEFT") == [thr] * 16
+    if dense and cfg.get("dense_settings"):
+        await drv.set(**cfg["dense_settings"])
     await ClockCycles(dut.clk, 50)  # the thresholds cross into the Harris clock
 
     for cam, idx in zip(cams, (0, 1)):
@@ -255,6 +266,14 @@ async def frames_bit_exact(dut):
                                                   **mp)
         return expected[key]
 
+    disparities = {}  # (digest of the rectified pair) -> the dense model's codes
+
+    def disparity_of(m):
+        key = frame_digest(m["rect_words"])
+        if key not in disparities:
+            disparities[key] = model.disparity(*m["rectified"], dsets)
+        return disparities[key]
+
     def find(pred, last, diff=None):
         hits = [(i, j) for i in range(n_cam) for j in range(max(0, i - 1), min(n_cam, i + 2)) if pred(model_of(i, j))]
         if not hits and diff is not None:
@@ -275,7 +294,7 @@ async def frames_bit_exact(dut):
         write_report(cfg, dict(mode=mode, width=w, height=h, speed=True, sim_us=sim_us, wall_s=round(wall, 2),
                                memory_clocks_per_s=round(sim_us * 100 / wall, 1)))
         return
-    results, last_rect, last_list = [], (-1, -1), (-1, -1)
+    results, last_rect, last_list, last_disp = [], (-1, -1), (-1, -1), (-1, -1)
     # a frame: up to two camera frames to the pair held, the rectification, the host's read-out before it
     # (memory clocks; the camera's frame period in PCLK of 1/18 us, the memory clock 100 MHz)
     timeout = max(5_000_000, int(6 * timing.frame_pclk * 100 / 17.9) + 40 * w * h)
@@ -337,6 +356,12 @@ async def frames_bit_exact(dut):
                 int(m["list"]["totals"][0]) == tot & 0xFFFF and int(m["list"]["totals"][1]) == tot >> 16
         find(counts_ok, (-1, -1))
         results[-1].update(totals=[tot & 0xFFFF, tot >> 16], thresholds=[list(map(int, c)) for c in cur])
+        if dense:
+            pd, got = await take_disparity(drv, amap, w, h, deadline_ns=3 * cam_ns, pr=pr, last=last_disp,
+                                           n_cam=n_cam, model_of=model_of, disparity_of=disparity_of)
+            last_disp = pd
+            last["disparity"] = got.tolist()
+            results[-1].update(disp_pair=pd, disp_ns=get_sim_time(unit="ns"))
         if adaptive is not None:  # the next frame's thresholds from this frame's block counts
             cur = tuple([int(v) for v in c.update(np.array(cnt))] for c, cnt in zip(ctrls, counts))
             await drv.configure(mode=mode, thresholds_left=cur[0], thresholds_right=cur[1])
@@ -353,6 +378,9 @@ async def frames_bit_exact(dut):
     arb = await drv.arbiter()
     assert st["dropped_left"] == st["dropped_right"] == 0, st
     assert st["harris_overflows"] == 0, st
+    if dense:
+        assert st["dense_overrun"] == 0 and st["disp_lost"] == 0, st
+        assert st["disp_frames"] >= len(results), st
     ovf = check_list_overflows(st, results, [model_of(i, j)["list"]["overflow"] for i in range(n_cam)
                                              for j in range(max(0, i - 1), min(n_cam, i + 2))]
                                if st["frames"] > len(results) and adaptive is None else None)
@@ -371,11 +399,49 @@ async def frames_bit_exact(dut):
         assert all(r["features"] > 0 for r in results) if adaptive is None else \
             any(r["features"] for r in results), [r["features"] for r in results]
     write_report(cfg, dict(mode=mode, width=w, height=h, threshold=thr, frames=results, bit_exact=True,
-                           model_params=mp, list_overflows=ovf, sdram=sdram,
+                           model_params=mp, list_overflows=ovf, sdram=sdram, dense=dsets,
+                           disp_frames=st["disp_frames"] if dense else None,
                            frame_clocks=st["frame_clocks"], frames_done=st["frames"], arb=arb,
                            arb_words=list(ARB_WORDS), total_ns=get_sim_time(unit="ns") - t_start,
                            camera_frame_pclk=timing.frame_pclk, axi=bus.checker.counts, last=last,
                            stages=stage_times(events, [r["start_ns"] for r in results])))
+
+
+def dense_settings(cfg: dict) -> dict | None:
+    """The dense model's keyword arguments for the top of ``cfg`` (None without the option): its
+    ``disparities`` and ``paths`` (or the block's defaults), the DENSE register's reset values updated by
+    ``dense_settings`` (what the bench writes), the top's fixed window and median."""
+    if not cfg["params"].get("dense", False):
+        return None
+    from eyestereo.hdl.system.stereo_frontend import stereo_frontend as top
+    from eyestereo.tools.regmap import REGMAP
+
+    sig = inspect.signature(top).parameters
+    out = {n: cfg["params"].get(n, sig[n].default) for n in ("disparities", "paths")}
+    out.update({f.name: f.reset for f in REGMAP["DENSE"].fields})
+    out.update(cfg.get("dense_settings") or {})
+    for flag in ("lr_check", "subpixel"):
+        out[flag] = bool(out[flag])
+    return out
+
+
+async def take_disparity(drv, amap, w: int, h: int, *, deadline_ns: float, pr, last, n_cam: int, model_of,
+                         disparity_of):
+    """Take the newest disparity map, read it and give it back (the host driver's ``take_disparity``); the stereo
+    pair (i, j) whose model it equals, searched from the rectified pair ``pr`` of the same round outwards (a map
+    may lag its pair or, the system going on, lead it), and moving on from ``last``. Returns the pair and the
+    codes read (height x width)."""
+    got = np.array(await drv.take_disparity(amap, timeout_clocks=int(max(deadline_ns, 2e6) / 10)),
+                   np.int64).reshape(h, w)
+    pairs = sorted(((i, j) for i in range(n_cam) for j in range(max(0, i - 1), min(n_cam, i + 2))),
+                   key=lambda p: (abs(p[0] - pr[0]) + abs(p[1] - pr[1]), p))
+    for p in pairs:
+        if p >= last and np.array_equal(disparity_of(model_of(*p)), got):
+            return p, got
+    want = disparity_of(model_of(*pr))
+    bad = np.argwhere(want != got)
+    raise AssertionError(f"the disparity map read equals the model of no stereo pair sent; against the pair "
+                         f"{pr} of the rectified images read: {len(bad)} codes differ, first {bad[:4].tolist()}")
 
 
 def check_list_overflows(st: dict, results: list[dict], candidates: list[bool] | None) -> dict:

@@ -11,11 +11,17 @@ The simulator is ``sim=`` or the ``SIM`` environment variable:
 Each configuration gets its own folder under ``build/sim/`` (conversion, simulator build, results,
 waveforms), so configurations can run in parallel; a folder is named after the test, with
 ``.icarus``, ``.verilator`` or ``.llvm`` added for the other simulators. ``WAVES=1`` keeps a waveform.
+
+A configuration converted once is converted again only when the code changes: :func:`cached_convert` keeps each
+conversion under ``build/sim/.convert/`` keyed by the block, its parameters, the language and a hash of every
+source file of ``hdl/`` and ``tools/`` (``EYESTEREO_CONVERT_CACHE=0`` turns it off).
 """
 
 from __future__ import annotations
 
 import contextlib
+import functools
+import hashlib
 import json
 import os
 import re
@@ -47,6 +53,65 @@ VERILATOR_ARGS = ["-Wno-fatal", "-Wno-lint", "-Wno-style", "-O3"]
 # camera word reached the SRAM on Icarus; GHDL and Verilator evaluate every combinational block at time 0).
 # As Verilog-2005 (the later -g wins) the initial values are time-0 events and those blocks run.
 ICARUS_ARGS = ["-g2005"]
+
+
+CONVERT_CACHE = BUILD / ".convert"
+
+
+@functools.cache
+def _source_key() -> str:
+    """A hash of every source the conversions depend on: hdl/ and tools/ (their Python files), MyHDL's version."""
+    import myhdl
+
+    h = hashlib.sha1(myhdl.__version__.encode())
+    for top in ("hdl", "tools"):
+        for f in sorted((ROOT / top).rglob("*.py")):
+            h.update(str(f.relative_to(ROOT)).encode() + b"\0" + f.read_bytes())
+    return h.hexdigest()
+
+
+def _plain(value) -> bool:
+    """A parameter the cache may key on: plain data whose text says everything (no object, no file the
+    conversion would read: a path or a calibration file's name)."""
+    if value is None or isinstance(value, (bool, int, float)):
+        return True
+    if isinstance(value, str):
+        return value.startswith("rig:") or not (os.sep in value or "." in value or value.startswith("opencv"))
+    if isinstance(value, (list, tuple)):
+        return all(_plain(v) for v in value)
+    if isinstance(value, dict):
+        return all(isinstance(k, str) and _plain(v) for k, v in value.items())
+    return False
+
+
+def cached_convert(block: str, build_dir: Path, **kw) -> list[Path]:
+    """:func:`eyestereo.hdl.flow.convert.convert` into ``build_dir``, or a copy of the same conversion made before
+    (same block, parameters and options, same sources: :func:`_source_key`). Parameters that are not plain data
+    (objects, files) are converted every time."""
+    if os.environ.get("EYESTEREO_CONVERT_CACHE", "1") == "0" or not _plain(kw):
+        return convert(block, build_dir, **kw)
+    key = hashlib.sha1(json.dumps([block, kw, _source_key()], sort_keys=True).encode()).hexdigest()[:20]
+    entry = CONVERT_CACHE / key
+    listing = entry / "files.json"
+    if listing.is_file():
+        out = []
+        for name in json.loads(listing.read_text()):
+            shutil.copy2(entry / name, build_dir / name)
+            out.append(build_dir / name)
+        return out
+    files = convert(block, build_dir, **kw)
+    # published whole or not at all: a parallel worker converting the same configuration renames second and loses
+    tmp = CONVERT_CACHE / f".{key}.{os.getpid()}"
+    shutil.rmtree(tmp, ignore_errors=True)
+    tmp.mkdir(parents=True)
+    for f in files:
+        shutil.copy2(f, tmp / f.name)
+    (tmp / "files.json").write_text(json.dumps([f.name for f in files]))
+    try:
+        os.rename(tmp, entry)
+    except OSError:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return files
 
 
 def slug(text: str) -> str:
@@ -320,7 +385,7 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
         raise ValueError(f"drivers='hdl' (the VHDL player and recorder) runs on GHDL only, not on {sim}")
     with _tool_env(sim, backend):
         if sim == "ghdl":
-            sources = convert(block, build_dir, **params)
+            sources = cached_convert(block, build_dir, **params)
             top = block
             wrapper = None
             if hdl_drivers:
@@ -351,7 +416,7 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
         else:
             # 1ns/1ps as the runner's timescale: as Verilog-2005 (ICARUS_ARGS) the file's own timescale
             # sets Icarus's precision, and MyHDL's 10 ps cannot hold the camera benches' clock periods.
-            sources = convert(block, build_dir, hdl="Verilog", timescale="1ns/1ps", **params)
+            sources = cached_convert(block, build_dir, hdl="Verilog", timescale="1ns/1ps", **params)
             if sim == "verilator" and public:
                 runner, vlt = _lean_verilator(build_dir, block, public)
                 sources = list(sources) + [vlt]

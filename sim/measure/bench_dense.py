@@ -20,7 +20,7 @@ import time
 from pathlib import Path
 
 from eyestereo.hdl.dense.sgm import spacing
-from eyestereo.sim.lib.runner import run_bench
+from eyestereo.sim.lib.runner import ghdl_backend, run_bench
 from eyestereo.tools.reports import markdown_table, publish
 
 BEGIN, END = "<!-- bench_dense: begin -->", "<!-- bench_dense: end -->"
@@ -48,7 +48,8 @@ def run(case: str, sim: str) -> dict:
     t0 = time.time()
     rep = run_bench(block, "tb_sgm", dict(frames=[pair], seed=1, pixel_clocks=1.2 * sp), name=f"measure_{case}",
                     params=params, sim=sim)
-    rep.update(wall=time.time() - t0, case=case, sim=sim, pu=params["pu"])
+    rep.update(wall=time.time() - t0, case=case, sim=f"ghdl ({ghdl_backend()})" if sim == "ghdl" else sim,
+               pu=params["pu"])
     RUNS.mkdir(parents=True, exist_ok=True)
     (RUNS / f"{case}_{sim}.json").write_text(json.dumps(rep, indent=2) + "\n")
     return rep

@@ -30,6 +30,8 @@ speed. Every run's report is kept in build/system/runs/ (``--reuse`` takes them 
     python -m eyestereo.sim.measure.bench_stereo_frontend [--sim verilator] [--size 352x288] [--frames 2]
         [--small 48x32] [--adaptive-frames 16] [--ghdl-speed 200] [--reuse] [--out docs/system.md]
     python -m eyestereo.sim.measure.bench_stereo_frontend --single-clock [--size 352x288] [--frames 2] [--frames-ovl 3]
+    python -m eyestereo.sim.measure.bench_stereo_frontend --dense [--memory sram] [--rectify fetch] [--frames 1]
+        [--frames-ovl 3] [--options-out docs/dense.md]
     python -m eyestereo.sim.measure.bench_stereo_frontend --real sequential,overlapped [--real-frames 1]
         [--real-pair LEFT RIGHT] [--real-size 352x288] [--real-threshold 16] [--sim verilator] [--reuse]
 """
@@ -707,6 +709,8 @@ def main_options(args) -> int:
 
     sim = args.sim or fastest_simulator()
     options = dict(memory=args.memory, rectify=args.rectify)
+    if args.dense:
+        options["dense"] = True
     w, h = (int(v) for v in args.size.split("x"))
     vga = (w, h) == (VGA_TIMING.width, VGA_TIMING.height)
     timing = (dict(h_blank=VGA_TIMING.h_blank, v_sync=VGA_TIMING.v_sync, v_back=VGA_TIMING.v_back,
@@ -724,11 +728,15 @@ def main_options(args) -> int:
     cam = CameraTiming(width=w, height=h, **timing)
     figs = {m: figures(r, cam) for m, r in reps.items()}
     title = f"{OPTIONS_TITLE[:-1]}, {args.size}: memory={args.memory}, rectify={args.rectify})"
+    if args.dense:
+        title = f"{DENSE_TITLE}, {args.size}: memory={args.memory}, rectify={args.rectify}"
     arb = reps["overlapped"].get("arb", {})
     moved = {k[6:]: v for k, v in arb.items() if k.startswith("moved_")}
     total = sum(moved.values()) or 1
     section = [title, "",
-               f"`stereo_frontend(memory=\"{args.memory}\", rectify=\"{args.rectify}\")`, rig calibration at "
+               f"`stereo_frontend(memory=\"{args.memory}\", rectify=\"{args.rectify}\"" +
+               (", dense=True)` (D 64, PU 4, 4 paths, census 5 x 5, the median; the DENSE register's reset settings)"
+                if args.dense else ")`") + ", rig calibration at "
                f"{args.size}, cameras {cam_mhz[0]:g} / {cam_mhz[1]:g} MHz, {sim_label(sim)}; every frame read back "
                "by the host over AXI4-Lite bit for bit against the numpy chain"
                + (", the SDRAM model checking every rule of the part (none broken, no refresh late)"
@@ -739,6 +747,8 @@ def main_options(args) -> int:
                f"The cameras' own rate: {min(cam_mhz) * 1e6 / cam.frame_pclk:.2f} frames/s (the slower camera, "
                f"{cam.frame_pclk} PCLK a frame at {min(cam_mhz):g} MHz): the overlapped mode keeps their pace when its "
                "frame period is the slower camera's.", ""]
+    if args.dense:
+        section += dense_lines(reps, figs, w, h)
     if args.memory == "sdram":
         sd = {m: r.get("sdram") or {} for m, r in reps.items()}
         section += ["SDRAM refreshes: " + ", ".join(f"{m} {v.get('refreshes', '?')} (late "
@@ -748,6 +758,27 @@ def main_options(args) -> int:
                           fps={m: round(f["fps"], 2) for m, f in figs.items()},
                           bit_exact={m: r["bit_exact"] for m, r in reps.items()})))
     return 0
+
+
+DENSE_TITLE = "## The front end with the dense option"
+
+
+def dense_lines(reps: dict, figs: dict, w: int, h: int) -> list[str]:
+    """What the dense runs add: the maps read and matched, the rectification's pace, the FIFO and writer flags."""
+    from eyestereo.hdl.dense.sgm import spacing
+
+    sp = spacing(64, 4)
+    out = []
+    for m, r in reps.items():
+        pairs = [tuple(f["disp_pair"]) for f in r["frames"]]
+        rect_us = (r.get("stages") or {}).get("rectify_us")
+        out.append(f"- {m}: {len(pairs)} disparity maps read by the host, each equal bit for bit to the dense model "
+                   f"of a rectified pair sent (pairs {pairs}); {r.get('disp_frames')} maps completed; "
+                   + (f"rectification {rect_us / 1e3:.3f} ms per pair (paced by the core, which takes {w} x {h} x "
+                      f"{sp} clocks = {w * h * sp / 1e5:.3f} ms at 100 MHz: the rectifier ends its FIFO's worth "
+                      "ahead of it); " if rect_us else "")
+                   + "the core's FIFO never overran and the writer lost no code (the bench's checks).")
+    return out + [""]
 
 
 def _size(text: str) -> str:
@@ -816,11 +847,17 @@ def main(argv=None) -> int:
     ap.add_argument("--reuse", action="store_true", help="take the runs' reports from build/system/runs/ if there")
     ap.add_argument("--memory", choices=("sram", "sdram"), help="only the top with this frame store, both modes at "
                     "--size; its section of --options-out is replaced in place")
-    ap.add_argument("--rectify", choices=("fetch", "stream"), default="stream",
-                    help="with --memory: the rectification option (default stream)")
-    ap.add_argument("--options-out", type=Path, default=ROOT / "docs" / "memory.md")
+    ap.add_argument("--rectify", choices=("fetch", "stream"), default=None,
+                    help="with --memory or --dense: the rectification option (default stream; fetch with --dense)")
+    ap.add_argument("--dense", action="store_true", help="the top with the dense option (D 64, PU 4), both modes at "
+                    "--size (default memory sram, rectify fetch); its section of --options-out (default docs/dense.md) "
+                    "is replaced in place")
+    ap.add_argument("--options-out", type=Path, default=None, help="default docs/memory.md (docs/dense.md with --dense)")
     args = ap.parse_args(argv)
-    if args.memory is not None:
+    if args.memory is not None or args.dense:
+        args.memory = args.memory or "sram"
+        args.rectify = args.rectify or ("fetch" if args.dense else "stream")
+        args.options_out = args.options_out or ROOT / "docs" / ("dense.md" if args.dense else "memory.md")
         return main_options(args)
     if args.real is not None:
         return main_real(args)

@@ -3,14 +3,16 @@
 ``python -m eyestereo.sim.measure.suite_time [--out docs/suite.md] [--jobs 2]`` runs the suite exactly as
 ``make test`` does (``pytest -n JOBS --dist worksteal``), in a child process, and records its wall time,
 the CPU time of all its processes (workers and simulators), the number of tests, and the slowest tests
-by pytest's own ``--durations``. Measure on a quiet machine: tests run beside other work take several
-times longer. The document is written only after a run in which every test passed.
+by pytest's own ``--durations``; every test's time (of a second or more) goes to ``tests/durations.json``, by
+which ``tests/conftest.py`` starts the longest tests first. Measure on a quiet machine: tests run beside other
+work take several times longer. The document is written only after a run in which every test passed.
 """
 
 from __future__ import annotations
 
 import argparse
 import datetime
+import json
 import os
 import platform
 import re
@@ -20,6 +22,7 @@ import sys
 import time
 from pathlib import Path
 
+from eyestereo.tools.io import atomic_write_text
 from eyestereo.tools.reports import publish
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -27,7 +30,7 @@ SLOWEST = 15
 
 
 def run(jobs: int) -> dict:
-    cmd = [sys.executable, "-m", "pytest", "-n", str(jobs), "--dist", "worksteal", f"--durations={SLOWEST}", "-q",
+    cmd = [sys.executable, "-m", "pytest", "-n", str(jobs), "--dist", "worksteal", "--durations=0", "-q",
            "-p", "no:cacheprovider"]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
@@ -38,8 +41,12 @@ def run(jobs: int) -> dict:
     out = r.stdout
     summary = re.findall(r"^=*\s*(\d+ passed.*?) in ([\d.]+)s", out, re.M)
     slow = re.findall(r"^([\d.]+)s (call|setup|teardown)\s+(\S+)", out, re.M)
+    every: dict[str, float] = {}
+    for sec, _, test in slow:
+        every[test] = round(every.get(test, 0.0) + float(sec), 1)
     return dict(rc=r.returncode, wall=wall, cpu=cpu, summary=summary[-1][0] if summary else "?",
-                pytest_s=float(summary[-1][1]) if summary else None, slow=slow[:SLOWEST], cmd=" ".join(cmd[2:]),
+                pytest_s=float(summary[-1][1]) if summary else None, slow=slow[:SLOWEST], every=every,
+                cmd=" ".join(cmd[2:]),
                 tail=(out + r.stderr).strip().splitlines()[-5:])
 
 
@@ -67,6 +74,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description="Time make test's pytest run and write docs/suite.md.")
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "suite.md")
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--durations", type=Path, default=ROOT / "tests" / "durations.json",
+                    help="every test's time of at least a second, which tests/conftest.py orders the suite by")
     args = ap.parse_args(argv)
     if args.jobs < 1:
         print("suite_time: --jobs must be at least 1", file=sys.stderr)
@@ -77,6 +86,8 @@ def main(argv=None) -> int:
               "\n".join(res["tail"]), file=sys.stderr)
         return 1
     publish(document(res, args.jobs), args.out)
+    atomic_write_text(args.durations, json.dumps({k: v for k, v in sorted(res["every"].items()) if v >= 1.0},
+                                                 indent=0) + "\n")
     return 0
 
 

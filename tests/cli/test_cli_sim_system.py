@@ -54,7 +54,26 @@ def test_sim_system_runs_the_front_end(cli, tmp_path, pair):
     assert "bit-exact: yes" in so
 
 
-@pytest.mark.parametrize("case", ["missing", "modes", "size", "frames", "parent", "sim"])
+@pytest.mark.othersims
+def test_sim_system_with_the_dense_option(cli, tmp_path, pair):
+    """--dense D: the front end with the dense option on Verilator; the host reads the disparity maps (the bench
+    compares them with the model), disparity.png is the last one, the summary gives D and the maps read."""
+    lp, rp = pair
+    out = tmp_path / "out"
+    code, so, se = cli("sim", "system", lp, rp, "-o", out, "--size", "48x32", "--frames", "2", "--modes",
+                       "overlapped", "--sim", "verilator", "--dense", "16", "--build-dir", tmp_path / "build")
+    assert code == 0, se
+    assert sorted(p.name for p in out.iterdir()) == ["disparity.png", "matches.png", "rectified.png", "summary.json"]
+    fig = json.loads((out / "summary.json").read_text())
+    assert fig["bit_exact"] is True and fig["dense"]["disparities"] == 16
+    assert fig["dense"]["maps_read"] == {"overlapped": 2} and fig["dense"]["maps_completed"]["overlapped"] >= 2
+    assert 0.3 < fig["dense"]["valid_last_map"] <= 1.0
+    pic = cv2.imread(str(out / "disparity.png"))
+    assert pic is not None and pic.shape[:2] == (32, 48)
+    assert "dense: D 16, disparity maps read 2" in so
+
+
+@pytest.mark.parametrize("case", ["missing", "modes", "size", "frames", "parent", "sim", "dense", "dense_wide"])
 def test_sim_system_bad_input(cli, tmp_path, pair, case):
     lp, rp = pair
     out = tmp_path / "out"
@@ -69,6 +88,10 @@ def test_sim_system_bad_input(cli, tmp_path, pair, case):
         argv += ["--frames", "0"]
     elif case == "sim":
         argv += ["--sim", "modelsim"]
+    elif case == "dense":
+        argv += ["--dense", "10"]
+    elif case == "dense_wide":
+        argv += ["--dense", "48"]  # the default 48x32 cameras: D must stay below 48
     else:
         argv[-1] = tmp_path / "no" / "out"
     code, so, se = cli(*argv)

@@ -102,7 +102,7 @@ def test_model_reset_values_and_rw():
     assert b.read(0x004) == (288 << 16 | 352, OKAY)
     assert b.read(0x014) == (10, OKAY) and b.outputs()["k_left"] == 10
     assert b.write(0x008, 0xFFFFFFFF) == OKAY
-    assert b.read(0x008) == (0x303, OKAY)  # mode, continuous, rect_want, feat_want only
+    assert b.read(0x008) == (0x703, OKAY)  # mode, continuous, rect_want, feat_want, disp_want only
     assert b.write(0x008, 0, strb=0x2) == OKAY  # byte 1: the want bits
     assert b.read(0x008) == (0x003, OKAY)
     assert b.outputs()["mode"] == 1 and b.outputs()["rect_want"] == 0
@@ -145,10 +145,11 @@ def test_driver_by_name_on_the_model():
         await drv.check_id()
         assert await drv.geometry() == (64, 48)
         await drv.configure(mode="overlapped", continuous=True, k_left=12, thresholds_right=[5, 6, 7])
-        assert b.outputs() | {} == dict(mode=1, continuous=1, rect_want=0, feat_want=0, k_left=12, k_right=10)
+        assert b.outputs() | {} == dict(mode=1, continuous=1, rect_want=0, feat_want=0, disp_want=0, k_left=12,
+                                        k_right=10, p1=10, p2=30, uniqueness=10, lr_check=1, subpixel=1)
         assert (await drv.read_thresholds("THR_RIGHT"))[:4] == [5, 6, 7, 0]
         await drv.set(rect_want=1, feat_want=1)
-        assert await drv.read_ctrl() == 0x303
+        assert await drv.read_ctrl() == 0x303  # disp_want (bit 10) not written: configure leaves it
         await drv.start()
         assert b.events[-1] == ("pulse", "start")
         with pytest.raises(BusError):
@@ -183,3 +184,12 @@ def test_driver_accessors_are_generated_from_the_table():
 def test_register_is_frozen():
     with pytest.raises(dataclasses.FrozenInstanceError):
         REGMAP["CTRL"].offset = 4
+
+
+def test_dense_register_resets_are_the_models_defaults():
+    """DENSE's reset values are the dense chain's tuned defaults (the host changes them only on purpose)."""
+    from eyestereo.tools.models.dense_stereo import DEFAULTS
+
+    resets = {f.name: f.reset for f in REGMAP["DENSE"].fields}
+    assert resets == {k: int(DEFAULTS[k]) for k in ("p1", "p2", "uniqueness", "lr_check", "subpixel")}
+    assert REGMAP["DENSE"].reset_value() == 10 | 30 << 8 | 10 << 16 | 1 << 24 | 1 << 25

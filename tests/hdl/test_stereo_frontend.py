@@ -56,19 +56,31 @@ def test_stereo_frontend(request, mode, single_clock):
 
 
 @pytest.mark.sim
-@pytest.mark.parametrize("mode,memory", [("sequential", "sram"), ("overlapped", "sram"), ("sequential", "sdram"),
-                                         ("overlapped", "sdram")])
+@pytest.mark.parametrize("mode,memory", [("overlapped", "sram"), ("sequential", "sdram")])
 def test_stereo_frontend_stream(request, mode, memory):
     """rectify="stream" (issue 26): the cameras' words into the line cache, the frames rectified as they arrive;
     the same register map, host driver and numpy chain; no camera word and no fetch in the frame store. With
     memory="sdram" the frame store is the ULX3S's SDRAM (its model checks every rule; the power-up wait shortened
-    to 1 us by the part's spec, which the controller and the model both read)."""
+    to 1 us by the part's spec, which the controller and the model both read). Each mode once and each memory
+    once (the sequencer's modes do not depend on the frame store: the other two pairs run on Verilator in
+    make test-sims, test_stereo_frontend_stream_more)."""
+    stream_run(request, mode, memory)
+
+
+@pytest.mark.othersims
+@pytest.mark.parametrize("mode,memory", [("sequential", "sram"), ("overlapped", "sdram")])
+def test_stereo_frontend_stream_more(request, mode, memory):
+    """The other two pairs of mode and frame store of test_stereo_frontend_stream, on Verilator."""
+    stream_run(request, mode, memory, sim="verilator")
+
+
+def stream_run(request, mode, memory, sim=None):
     extra = dict(memory="sdram", sdram_part="AS4C32M16SB-7:powerup_us=1") if memory == "sdram" else {}
     rep = run_bench("stereo_frontend", "tb_stereo_frontend",
                     dict(mode=mode, frames=3, images="shift:3", timing=TIMING, require_features=True, pause=0.0,
                          adaptive=None),
-                    name=request.node.name, params=dict(quantizers=SPEC, feature_words=256, max_features=127,
-                                                        rectify="stream", **extra))
+                    name=request.node.name, sim=sim, params=dict(quantizers=SPEC, feature_words=256,
+                                                                 max_features=127, rectify="stream", **extra))
     assert rep["bit_exact"] and len(rep["frames"]) == 3
     if memory == "sdram":  # the bench asserted no rule broken; refreshes ran (tREFI 7.8 us) and none was late
         assert rep["sdram"]["refreshes"] > 20 and rep["sdram"]["late_refreshes"] == 0
@@ -257,3 +269,59 @@ def test_list_overflows_rule():
     assert check_list_overflows(dict(frames=4, list_overflows=2), read, [True, False])["expected"] == [1, 3]
     with pytest.raises(AssertionError):
         check_list_overflows(dict(frames=4, list_overflows=4), read, [True, False])
+
+
+@pytest.mark.sim
+@pytest.mark.parametrize("mode,rectify,sim", [("overlapped", "fetch", "ghdl"), ("sequential", "stream", "verilator")])
+def test_stereo_frontend_dense(request, mode, rectify, sim):
+    """The dense option (issue 28): the disparity map of every rectified pair into the disparity buffers, taken
+    by the host through the same handshake; each map read equals the dense model of a rectified pair sent, with
+    the DENSE settings the host wrote (P1 8, P2 40, uniqueness 15, no sub-pixel step), the core never overran
+    its FIFO and the writer lost no code (the bench asserts both). The VHDL on GHDL in one configuration, the
+    Verilog on Verilator in the other (GHDL takes three minutes on a dense front end: the suite's budget)."""
+    d, pu = 16, 4
+    settings = dict(p1=8, p2=40, uniqueness=15, subpixel=0)
+    rep = run_bench("stereo_frontend", "tb_stereo_frontend",
+                    dict(mode=mode, frames=3, images="shift:3", timing=TIMING, require_features=False, pause=0.0,
+                         adaptive=None, dense_settings=settings),
+                    name=request.node.name, sim=sim, backend=runner.fastest_ghdl_backend() if sim == "ghdl" else None,
+                    params=dict(quantizers=SPEC, feature_words=256, max_features=127, rectify=rectify, dense=True,
+                                disparities=d, pu=pu))
+    assert rep["bit_exact"] and len(rep["frames"]) == 3
+    assert rep["dense"]["p2"] == 40 and rep["dense"]["subpixel"] is False and rep["dense"]["disparities"] == d
+    disp = [tuple(f["disp_pair"]) for f in rep["frames"]]
+    assert disp == sorted(disp) and len(set(disp)) == 3, disp
+    assert rep["disp_frames"] >= 3
+
+
+def test_dense_option_parameters_are_checked():
+    """The dense option's parameters and the disparity writer's are refused with one line naming them."""
+    from eyestereo.hdl.flow.catalog import get
+    from eyestereo.hdl.interfaces.sram_bus import HostPort
+    from eyestereo.hdl.interfaces.stream import ImageStream
+    from eyestereo.hdl.system.disparity_writer import disparity_writer
+    from myhdl import ResetSignal, Signal, intbv
+
+    spec = get("stereo_frontend")
+    for params, words in ((dict(disparities=32), "32-pixel rows must be wider"),
+                          (dict(disparities=24, pu=16), "pu must divide"),
+                          (dict(pu=3), "pu"), (dict(paths=3), "paths"), (dict(dense=1), "dense")):
+        with pytest.raises(ValueError, match=words):
+            spec.elaborate(quantizers=SPEC, **{"dense": True, "disparities": 16, **params})
+    # the dense map does not fit the 1M words at 640x480 with the camera buffers
+    with pytest.raises(ValueError, match="need .* words, the SRAM has"):
+        spec.elaborate(quantizers="rig:640x480", dense=True)
+
+    def writer(**kw):
+        b = lambda: Signal(bool(0))  # noqa: E731
+        args = dict(base0=0, base1=100, width=10, height=10, depth=16)
+        args.update(kw)
+        rst = ResetSignal(0, active=1, isasync=False)
+        return disparity_writer(Signal(bool(0)), rst, ImageStream(16), HostPort(), HostPort(), b(), b(), b(), b(), b(),
+                                Signal(intbv(0)[16:]), b(), **args)
+
+    writer()  # a good one elaborates
+    for kw, words in ((dict(depth=24), "power of two"), (dict(base1=50), "overlap"),
+                      (dict(base1=(1 << 20) - 50), "past the 20-bit"), (dict(depth=8), "depth")):
+        with pytest.raises(ValueError, match=words):
+            writer(**kw)

@@ -1,4 +1,4 @@
-"""Bit-true model of the future ``dense_stereo`` block (issue 28): census, SGM and the optional median.
+"""Bit-true model of :func:`eyestereo.hdl.dense.dense_stereo.dense_stereo`: census, SGM and the optional median.
 
 The chain: a stereo image stream (8-bit left and right, rectified) in; the census words of both cameras
 (:mod:`~eyestereo.tools.models.census`); semi-global matching with winner take all, uniqueness, left-right
@@ -17,15 +17,16 @@ from __future__ import annotations
 
 import numpy as np
 
+from eyestereo.tools.constants import DENSE_DEFAULTS
 from eyestereo.tools.models.census import census_stereo
 from eyestereo.tools.models.median3 import median3
 from eyestereo.tools.models.sgm import INVALID, sgm
 
 __all__ = ["DEFAULTS", "WIDTHS", "INVALID", "dense_stereo", "to_float"]
 
-#: The chain's defaults (tuned, docs/dense.md); the float reference takes the same names.
-DEFAULTS = dict(window=5, disparities=64, paths=4, p1=10, p2=30, uniqueness=10, lr_check=True, subpixel=True,
-                median=True)
+#: The chain's defaults (tuned, docs/dense.md; the DENSE register's reset values); the float reference takes the
+#: same names.
+DEFAULTS = dict(DENSE_DEFAULTS)
 #: The widths chosen by measurement (docs/dense.md, the table of the cuts): full Hamming costs, path costs of
 #: 7 bits (exact up to P2 = 103 with the 5 x 5 census; the defaults need 6), one LSB dropped from the sums
 #: of the paths, 4 fractional bits.

@@ -95,12 +95,17 @@ class AddressMap:
                                                           base + y * width + x
     rectified, buffer b     width x height each (2)       :data:`RECT_WORD` (left and right pixel of (x, y))
     feature list, buffer b  ``feature_words`` each (2)    the list's words in order
+    disparity, buffer b     width x height each (2)       ``dense=True`` only: the dense option's disparity
+                                                          code of left pixel (x, y) (1/16 px, 0xFFFF none)
     host area               the rest up to 1M             free for the host's own use
     ======================  ============================  ===============================================
 
     ``cameras=False`` (the front end's ``rectify="stream"``: the cameras go to the line cache, not the memory): no
     camera buffers, the rectified buffers from address 0 and the rest moved down with them, so that 640x480
     frames fit the 1M words too (2 x 307,200 + the lists). The camera writers' bases are then 0 (they never write).
+
+    ``dense=True`` (the front end's ``dense`` option): two disparity buffers after the feature lists, written through
+    the host port by :func:`~eyestereo.hdl.system.disparity_writer.disparity_writer` (``bases("disp")``).
     """
 
     width: int = FRAME_WIDTH
@@ -108,6 +113,7 @@ class AddressMap:
     feature_words: int = 8192
     words: int = WORDS
     cameras: bool = True
+    dense: bool = False
 
     def __post_init__(self):
         for name in ("width", "height", "feature_words"):
@@ -115,9 +121,9 @@ class AddressMap:
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 2:
                 raise ValueError(f"AddressMap {name} must be an int >= 2, got {v!r}")
         if self.host_base > self.words:
-            raise ValueError(f"{self.width}x{self.height} frames: {self._frames} buffers of {self.frame} words and 2 "
-                             f"feature lists of {self.feature_words} need {self.host_base} words, the SRAM has "
-                             f"{self.words}")
+            raise ValueError(f"{self.width}x{self.height} frames: {self._frames + 2 * self.dense} buffers of "
+                             f"{self.frame} words and 2 feature lists of {self.feature_words} need {self.host_base} "
+                             f"words, the SRAM has {self.words}")
 
     @property
     def _frames(self) -> int:
@@ -143,8 +149,16 @@ class AddressMap:
         self._check(0, buf)
         return self._frames * self.frame + buf * self.feature_words
 
+    def disparity(self, buf: int) -> int:
+        """Base address of disparity buffer ``buf`` (``dense=True`` only)."""
+        self._check(0, buf)
+        if not self.dense:
+            raise ValueError("this map has no disparity buffers (dense=False)")
+        return self._frames * self.frame + 2 * self.feature_words + buf * self.frame
+
     def bases(self, writer: str) -> tuple[int, int]:
-        """Base addresses of the two buffers of ``writer`` (a name of :data:`WRITERS`)."""
+        """Base addresses of the two buffers of ``writer`` (a name of :data:`WRITERS`, or ``"disp"``: the
+        disparity buffers of a ``dense`` map)."""
         if writer in ("cam0", "cam1"):
             if not self.cameras:
                 return 0, 0
@@ -153,7 +167,9 @@ class AddressMap:
             return self.rectified(0), self.rectified(1)
         if writer == "feat":
             return self.features(0), self.features(1)
-        raise ValueError(f"no buffers for {writer!r}: the writers are {WRITERS}")
+        if writer == "disp":
+            return self.disparity(0), self.disparity(1)
+        raise ValueError(f"no buffers for {writer!r}: the writers are {WRITERS} (and 'disp')")
 
     def size(self, writer: str) -> int:
         """Words of each buffer of ``writer``."""
@@ -162,7 +178,7 @@ class AddressMap:
 
     @property
     def host_base(self) -> int:
-        return self._frames * self.frame + 2 * self.feature_words
+        return (self._frames + 2 * self.dense) * self.frame + 2 * self.feature_words
 
     def pixel(self, base: int, x, y):
         """Address of pixel (x, y) in the frame buffer at ``base`` (numpy arrays welcome)."""
@@ -174,6 +190,7 @@ class AddressMap:
                if self.cameras]
         out += [(f"rectified buffer {b}", self.rectified(b), self.frame) for b in (0, 1)]
         out += [(f"feature list {b}", self.features(b), self.feature_words) for b in (0, 1)]
+        out += [(f"disparity buffer {b}", self.disparity(b), self.frame) for b in (0, 1) if self.dense]
         out.append(("host area", self.host_base, self.words - self.host_base))
         return out
 
