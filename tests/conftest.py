@@ -36,6 +36,10 @@ def _durations() -> dict:
 
 
 def _workers(config) -> int:
+    """The number of xdist workers (collection runs in each worker, which learns the count from its controller)."""
+    wi = getattr(config, "workerinput", None)
+    if wi and "workercount" in wi:
+        return int(wi["workercount"])
     n = getattr(config.option, "numprocesses", None)
     return n if isinstance(n, int) and n > 0 else 1
 

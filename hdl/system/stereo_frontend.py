@@ -202,10 +202,11 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
         raise block_error("parameter cache_lines is for rectify='stream' (the line cache)")
 
     dense = check_bool("dense", dense)
+    # checked with or without the option (a bad value is refused, not ignored); how they fit the frame only with it
+    disparities = check_int("disparities", disparities, *D_RANGE)
+    pu = check_choice("pu", pu, PU_CHOICES)
+    paths = check_choice("paths", paths, PATHS)
     if dense:
-        disparities = check_int("disparities", disparities, *D_RANGE)
-        pu = check_choice("pu", pu, PU_CHOICES)
-        paths = check_choice("paths", paths, PATHS)
         if disparities % pu or disparities // pu < 2:
             raise block_error(f"parameters disparities={disparities}, pu={pu}: pu must divide the disparities into "
                               "groups of at least two")

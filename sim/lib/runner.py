@@ -13,8 +13,9 @@ waveforms), so configurations can run in parallel; a folder is named after the t
 ``.icarus``, ``.verilator`` or ``.llvm`` added for the other simulators. ``WAVES=1`` keeps a waveform.
 
 A configuration converted once is converted again only when the code changes: :func:`cached_convert` keeps each
-conversion under ``build/sim/.convert/`` keyed by the block, its parameters, the language and a hash of every
-source file of ``hdl/`` and ``tools/`` (``EYESTEREO_CONVERT_CACHE=0`` turns it off).
+conversion under the build root's ``.convert/`` (``build/sim/.convert/``) keyed by the block, its parameters, the
+language and a hash of every source file of ``hdl/`` and ``tools/`` (``EYESTEREO_CONVERT_CACHE=0`` turns it
+off).
 """
 
 from __future__ import annotations
@@ -84,14 +85,15 @@ def _plain(value) -> bool:
     return False
 
 
-def cached_convert(block: str, build_dir: Path, **kw) -> list[Path]:
+def cached_convert(block: str, build_dir: Path, cache: Path | None = None, **kw) -> list[Path]:
     """:func:`eyestereo.hdl.flow.convert.convert` into ``build_dir``, or a copy of the same conversion made before
-    (same block, parameters and options, same sources: :func:`_source_key`). Parameters that are not plain data
-    (objects, files) are converted every time."""
+    (same block, parameters and options, same sources: :func:`_source_key`) kept in ``cache`` (default
+    :data:`CONVERT_CACHE`). Parameters that are not plain data (objects, files) are converted every time."""
     if os.environ.get("EYESTEREO_CONVERT_CACHE", "1") == "0" or not _plain(kw):
         return convert(block, build_dir, **kw)
     key = hashlib.sha1(json.dumps([block, kw, _source_key()], sort_keys=True).encode()).hexdigest()[:20]
-    entry = CONVERT_CACHE / key
+    root = CONVERT_CACHE if cache is None else Path(cache)
+    entry = root / key
     listing = entry / "files.json"
     if listing.is_file():
         out = []
@@ -101,7 +103,7 @@ def cached_convert(block: str, build_dir: Path, **kw) -> list[Path]:
         return out
     files = convert(block, build_dir, **kw)
     # published whole or not at all: a parallel worker converting the same configuration renames second and loses
-    tmp = CONVERT_CACHE / f".{key}.{os.getpid()}"
+    tmp = root / f".{key}.{os.getpid()}"
     shutil.rmtree(tmp, ignore_errors=True)
     tmp.mkdir(parents=True)
     for f in files:
@@ -385,7 +387,7 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
         raise ValueError(f"drivers='hdl' (the VHDL player and recorder) runs on GHDL only, not on {sim}")
     with _tool_env(sim, backend):
         if sim == "ghdl":
-            sources = cached_convert(block, build_dir, **params)
+            sources = cached_convert(block, build_dir, Path(build_root) / ".convert", **params)
             top = block
             wrapper = None
             if hdl_drivers:
@@ -416,7 +418,8 @@ def run_bench(block: str, bench: str, config: dict, *, name: str, params: dict |
         else:
             # 1ns/1ps as the runner's timescale: as Verilog-2005 (ICARUS_ARGS) the file's own timescale
             # sets Icarus's precision, and MyHDL's 10 ps cannot hold the camera benches' clock periods.
-            sources = cached_convert(block, build_dir, hdl="Verilog", timescale="1ns/1ps", **params)
+            sources = cached_convert(block, build_dir, Path(build_root) / ".convert", hdl="Verilog",
+                                     timescale="1ns/1ps", **params)
             if sim == "verilator" and public:
                 runner, vlt = _lean_verilator(build_dir, block, public)
                 sources = list(sources) + [vlt]

@@ -93,7 +93,7 @@ def test_a_word_that_does_not_fit_is_refused(bank, drv):
     # was 5 (the 32-bit mask, then the bank kept the field's 8 bits)
     refused(drv.write("K_LEFT", (1 << 32) + 5), "K_LEFT: 4294967301 does not fit (0..255, 8 bits)")
     refused(drv.write_k_left(0x105), "K_LEFT: 261 does not fit (0..255, 8 bits)")  # was 5
-    refused(drv.write("CTRL", 0x4), "CTRL: 4 does not fit (the fields' bits 0x303 only)")  # a bit no field has
+    refused(drv.write("CTRL", 0x4), "CTRL: 4 does not fit (the fields' bits 0x703 only)")  # a bit no field has
     refused(drv.write("THR_LEFT", 1 << 20, 3), f"THR_LEFT[3]: 1048576 does not fit {THR}")
     refused(drv.write("THR_LEFT", 7.0, 3), f"THR_LEFT[3]: 7.0 is not an integer {THR}")
     refused(drv.write("CTRL", 1, strb=0x10), "CTRL wstrb: 16 does not fit (0..15, 4 bits)")

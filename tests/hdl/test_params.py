@@ -262,7 +262,7 @@ STANDARD = sorted(n for n, s in BLOCKS.items() if s.build is None)
 
 def _small(spec):
     small = {k: v for k, v in SMALL_FRAME.items() if k in spec.defaults}
-    if "disparities" in spec.defaults:
+    if "disparities" in spec.defaults and "width" in spec.defaults:
         small.update(width=24, disparities=16)  # the dense blocks' frame must be wider than D
     return small
 

@@ -88,9 +88,10 @@ def test_doc_section_replaced_in_place(tmp_path):
 
 
 def test_block_with_more_ports_than_pins_is_placed_out_of_context(tmp_path):
-    """The register bank (495 port bits, more than any ECP5 package's I/O) still gets an fmax, marked so."""
+    """The register bank (543 port bits with the dense option's fields, more than any ECP5 package's I/O) still
+    gets an fmax, marked so."""
     r = synth_block("register_bank", tmp_path, pnr=True)
-    assert "out_of_context" in r and "495 port bits" in r["out_of_context"], r.get("ecp5_device")
+    assert "out_of_context" in r and "543 port bits" in r["out_of_context"], r.get("ecp5_device")
     assert "--out-of-context" in r["ecp5_device"]
     f = r["fmax"]["clk"]
     assert f["achieved"] is not None and 50.0 < f["achieved"] < 1000.0, f

@@ -118,15 +118,17 @@ def test_the_map_without_camera_buffers():
 
 def test_the_map_with_disparity_buffers():
     """dense=True (the front end's dense option): two disparity buffers of a frame each after the feature lists,
-    the host area after them; CIF fits (8 frames + 2 lists = 827,392 words), the map without them has none."""
+    the host area after them; CIF fits (8 frames + 2 lists = 827,392 words), VGA does not; the map without them has
+    none."""
     m = AddressMap(352, 288, 8192, dense=True)
     f = 352 * 288
     assert m.disparity(0) == 6 * f + 2 * 8192 and m.disparity(1) == 7 * f + 2 * 8192
     assert m.bases("disp") == (m.disparity(0), m.disparity(1)) and m.host_base == 8 * f + 2 * 8192
-    assert [r[0] for r in m.regions()][6:9] == ["disparity buffer 0", "disparity buffer 1", "host area"]
+    assert [r[0] for r in m.regions()][8:11] == ["disparity buffer 0", "disparity buffer 1", "host area"]
     with pytest.raises(ValueError, match="no disparity buffers"):
         AddressMap(352, 288, 8192).disparity(0)
-    s = AddressMap(640, 480, 8192, cameras=False, dense=True)  # VGA with the line cache: 4 frames fit too
-    assert s.disparity(0) == 2 * 307_200 + 2 * 8192 and s.host_base == 4 * 307_200 + 2 * 8192
-    with pytest.raises(ValueError, match="8 buffers of 307200 words"):
-        AddressMap(640, 480, 8192, dense=True)
+    s = AddressMap(352, 288, 8192, cameras=False, dense=True)  # the line cache's map: the maps after the lists
+    assert s.disparity(0) == 2 * f + 2 * 8192 and s.host_base == 4 * f + 2 * 8192
+    # VGA does not fit the 1M words with the maps, even without the camera buffers (4 x 307,200 + the lists)
+    with pytest.raises(ValueError, match="4 buffers of 307200 words and 2 feature lists of 8192 need 1245184"):
+        AddressMap(640, 480, 8192, cameras=False, dense=True)
