@@ -96,7 +96,7 @@ test-sims: setup
 # --dist worksteal: a worker that runs out of tests takes queued ones from the other (with the default
 # scheduler one core sat idle for the last 7 minutes of a 2-worker run while the other ran the SRAM benches).
 test: setup lint
-	$(PY) -m pytest -n $(JOBS) --dist worksteal --durations=25
+	$(PY) -m pytest -n $(JOBS) --dist worksteal --durations=60
 
 # ruff (pycodestyle, pyflakes, bugbear, pyupgrade) and vulture (dead code), configured in pyproject.toml;
 # vulture's known false positives (names only cocotb, MyHDL or pytest call) are listed in .vulture_allow.py

@@ -46,11 +46,18 @@ def fresh_names() -> None:
     """Forget the block names MyHDL has handed out in this process. MyHDL makes each instance name unique over the
     whole process by appending ``_0``, ``_1``, ... to it, every repeat again: in a test worker that has converted the
     front end a dozen times, nested blocks' names passed GHDL's 1023-character limit (issue 26). Each conversion is
-    its own design, so its names need only be unique within it."""
+    its own design, so its names need only be unique within it.
+
+    The per-block call counters (``en_reg0``, ``en_reg1``, ...) are reset too: MyHDL resets them only after an
+    elaboration that completes, so one that raised half-way (a refused parameter) or a MyHDL ``Simulation`` left
+    them counting, and the next conversion's names depended on what ran before it in the process."""
+    import myhdl
     import myhdl._block as mb
 
     mb._name_set.clear()
     mb._inst_name_set.clear()
+    for deco in myhdl._simulator._blocks:
+        deco.calls = 0
 
 
 def convert(name: str, path: Path, *, hdl: str = "VHDL", entity: str | None = None, timescale: str | None = None,
