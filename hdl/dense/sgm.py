@@ -226,7 +226,11 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
     insts += [pairing, clear, fifo_write, fifo_read, popper, fifo_ctrl]
 
     # ------------------------------------------------------------------ sequencer: the groups' beats
-    popd = Signal(bool(0))                     # the popped pair is in fq
+    popd1 = Signal(bool(0))                    # the popped pair is in fq (the FIFO's block RAM output)
+    popd = Signal(bool(0))                     # ... and in fq_r
+    # fq registered once more before the census ring: the FIFO RAM's output straight into the lanes' census
+    # RAMs was a slowest memory-clock path of the dense front end (5.8 ns of block RAM clock-to-out, then routing)
+    fq_r = Signal(intbv(0)[2 * nbits:])
     px = Signal(intbv(0, min=0, max=width))    # the next pixel's position
     py = Signal(intbv(0, min=0, max=height))
     ppos = Signal(intbv(0, min=0, max=ring))   # its place in the previous rows' ring
@@ -251,6 +255,7 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
     @always(clk.posedge)
     def sequencer():
         if clr:
+            popd1.next = False
             popd.next = False
             bv.next = False
             px.next = 0
@@ -260,7 +265,8 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
             ppos2.next = 2 % ring
             pk.next = 0
         else:
-            popd.next = pop
+            popd1.next = pop
+            popd.next = popd1
             if popd:
                 bv.next = True
                 bg.next = 0
@@ -320,18 +326,22 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
     cwd = Signal(intbv(0)[nbits:])
     cl_pix = Signal(intbv(0)[nbits:])
 
+    @always(clk.posedge)
+    def fq_reg():
+        fq_r.next = fq
+
     @always_comb
     def census_write():
         cwe.next = popd and not clr
         cwa.next = px % rr
-        cwd.next = fq[nbits:]
+        cwd.next = fq_r[nbits:]
 
     @always(clk.posedge)
     def left_word():
         if bv and bfirst:
-            cl_pix.next = fq[2 * nbits:nbits]
+            cl_pix.next = fq_r[2 * nbits:nbits]
 
-    insts += [census_write, left_word]
+    insts += [fq_reg, census_write, left_word]
 
     # candidates d0 + k <= x, per lane (stage 0), for the costs (stage 4) and the sums (stage S_S)
     cand = [Signal(bool(0)) for _ in range(pu)]
@@ -698,7 +708,13 @@ def path(clk, clr, bv, bg, rpos, start, first3, last3, v7, first7, last7, g7, po
     # the minimum of p - r, at stage S_L - 1 (the recurrence's last)
     mloop = Signal(intbv(0)[pb:])
     gmin = Signal(intbv(0)[pb:])
-    insts.append(min_tree(clk, list(lanes), gmin))
+    if dy != 0:
+        # a row path's minimum is read a row later: a register after every comparator level costs no spacing
+        # (two levels in a clock were the dense front end's slowest memory-clock path after placement)
+        tl = tree_latency(pu, 1)
+        insts.append(min_tree(clk, list(lanes), gmin, per_stage=1))
+    else:
+        insts.append(min_tree(clk, list(lanes), gmin))  # the loop's: its latency is in the spacing
     vw = Signal(bool(0))
     insts.append(delay_clr(clk, clr, v7, vw, clocks=tl))
     firstw = Signal(bool(0))

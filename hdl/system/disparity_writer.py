@@ -105,7 +105,9 @@ def disparity_writer(clk, rst, sink, bank, mem, want, release, held, avail, buf,
     # port's multiplexer and the double buffer's handshake) then come from LUT-RAM. Reads are issued on credit:
     # the small FIFO's entries and the two reads on their way never exceed OUT.
     aw = depth.bit_length() - 1
-    ram = [Signal(intbv(0)[ENTRY.width:]) for _ in range(depth)]
+    # _norw: never read where written in the same clock (a read needs n != 0, a write n != depth: rp == wp only
+    # when empty or full), so Yosys builds no collision logic between the RAM and q
+    ram_norw = [Signal(intbv(0)[ENTRY.width:]) for _ in range(depth)]
     din, q, q2, head = (Signal(intbv(0)[ENTRY.width:]) for _ in range(4))
     wp, rp = Signal(intbv(0)[aw:]), Signal(intbv(0)[aw:])
     n = Signal(intbv(0, min=0, max=depth + 1))  # entries in the block RAM
@@ -154,9 +156,9 @@ def disparity_writer(clk, rst, sink, bank, mem, want, release, held, avail, buf,
     def storage():
         # no reset: a block RAM with a registered, enabled read port (q), then a plain register (q2)
         if push:
-            ram[wp].next = din
+            ram_norw[wp].next = din
         if issue:
-            q.next = ram[rp]
+            q.next = ram_norw[rp]
         q2.next = q
 
     @always_seq(clk.posedge, reset=rst)

@@ -35,9 +35,10 @@ DENSE_CROP = (96, 64)
 
 def codes(spec: str, width: int, height: int) -> np.ndarray:
     """A code map: ``random:SEED`` (uniform 16-bit codes, a fifth of them INVALID), ``levels:SEED`` (codes
-    of {0, 1, 2, 0xFFFE, INVALID}: mostly ties), or ``dense:DIR`` (the bottom-right ``width`` x ``height``
+    of {0, 1, 2, 0xFFFE, INVALID}: mostly ties), ``dense:DIR`` (the bottom-right ``width`` x ``height``
     of the disparity codes, no median, of ``DIR``'s im3.png / im4.png, centre crop ``DENSE_CROP``, 16
-    disparities)."""
+    disparities) or ``npy:FILE`` (the bottom-right ``width`` x ``height`` of a code map saved with numpy: a
+    full frame's, sim/measure/bench_dense.py)."""
     kind, _, arg = spec.partition(":")
     if kind == "random":
         rng = np.random.default_rng(int(arg))
@@ -56,6 +57,11 @@ def codes(spec: str, width: int, height: int) -> np.ndarray:
             grey.append(centre_crop(img, *DENSE_CROP, name))
         full = dense_stereo(*grey, disparities=16, median=False)
         return full[-height:, -width:].astype(np.int64)
+    if kind == "npy":
+        m = np.load(arg)
+        if m.ndim != 2 or m.shape[0] < height or m.shape[1] < width:
+            raise ValueError(f"{arg}: a {m.shape} array holds no {height} x {width} code map")
+        return m[-height:, -width:].astype(np.int64)
     raise ValueError(f"unknown code map {spec!r}")
 
 

@@ -1,7 +1,8 @@
 """Measure the dense-disparity blocks on full frames and write docs/dense.md's "Full frames" section.
 
 Each case is a Tsukuba pair (the centre 352 x 288 of im3 / im4, the cameras' size) through a block's HDL
-(``sgm`` on the census model's words, or the whole ``dense_stereo`` chain on the grey pair) with D = 64, 4
+(``sgm`` on the census model's words, or the whole ``dense_stereo`` chain on the grey pair; ``census`` and
+``median3`` on their own, a table of their own) with D = 64, 4
 paths, PU = 4 unless the case says otherwise, fed at about 1.2 x the block's pixel spacing with random idle
 gaps (sim/benches/tb_sgm.py), every code compared with the bit-true model. Reported: bit-exact (the bench
 fails otherwise), the pixels and valid codes, the pixel spacing, the clocks from the frame's first input to
@@ -9,7 +10,7 @@ its last output, what the spacing allows at 100 MHz (frames per second: ``1e8 / 
 height)``), the lag of a row's codes after its last input pixel, the simulator and its wall time.
 
 Run: ``python -m eyestereo.sim.measure.bench_dense --out docs/dense.md [--sims verilator,icarus,ghdl]
-[--cases sgm,dense_stereo] [--reuse]`` (each run's report is kept in build/dense_runs/; ``--reuse`` takes those).
+[--cases sgm,dense_stereo,census,median3] [--reuse]`` (each run's report is kept in build/dense_runs/; ``--reuse`` takes those).
 """
 
 from __future__ import annotations
@@ -31,7 +32,11 @@ HW = dict(window=5, disparities=64, pu=4, paths=4, path_bits=7, sum_shift=1, fra
           width=WIDTH, height=HEIGHT)
 RUNS = Path("build/dense_runs")  # each run's report, for --reuse
 CASES = {"sgm": ("sgm", {}), "dense_stereo": ("dense_stereo", dict(median=True, fifo=None)),
-         "sgm_pu8": ("sgm", dict(pu=8))}
+         "sgm_pu8": ("sgm", dict(pu=8)),
+         # the two blocks around sgm, on their own: census on the grey pair (both cameras' words), median3 on
+         # the full frame's codes of the model's census + SGM (no median), at 0.7 beats per clock
+         "census": ("census", {}), "median3": ("median3", {})}
+SMALL = ("census", "median3")
 
 
 def data_dir() -> Path:
@@ -40,7 +45,42 @@ def data_dir() -> Path:
     return here if here.is_dir() else DATA
 
 
+def codes_file() -> Path:
+    """The model's disparity codes (census + SGM, no median) of the Tsukuba pair's centre, for median3."""
+    import cv2
+    import numpy as np
+
+    from eyestereo.tools.io import centre_crop
+    from eyestereo.tools.models.dense_stereo import dense_stereo
+
+    f = RUNS / f"tsukuba_codes_{WIDTH}x{HEIGHT}.npy"
+    if not f.is_file():
+        grey = [centre_crop(cv2.imread(str(data_dir() / n), cv2.IMREAD_GRAYSCALE), WIDTH, HEIGHT, n)
+                for n in ("im3.png", "im4.png")]
+        RUNS.mkdir(parents=True, exist_ok=True)
+        np.save(f, dense_stereo(*grey, disparities=HW["disparities"], median=False))
+    return f
+
+
+def run_small(case: str, sim: str) -> dict:
+    """census or median3 on one full frame (their benches: tb_census, tb_median3)."""
+    t0 = time.time()
+    if case == "census":
+        pair = [f"image:{data_dir() / 'im3.png'}", f"image:{data_dir() / 'im4.png'}"]
+        rep = run_bench("census", "tb_census", dict(frames=[pair], duty=0.7, seed=1), name="measure_census",
+                        params=dict(window=HW["window"], width=WIDTH, height=HEIGHT, stereo=True), sim=sim)
+    else:
+        rep = run_bench("median3", "tb_median3", dict(frames=[f"npy:{codes_file()}"], duty=0.7, seed=1),
+                        name="measure_median3", params=dict(width=WIDTH, height=HEIGHT), sim=sim)
+    rep.update(wall=time.time() - t0, case=case, sim=f"ghdl ({ghdl_backend()})" if sim == "ghdl" else sim)
+    RUNS.mkdir(parents=True, exist_ok=True)
+    (RUNS / f"{case}_{sim}.json").write_text(json.dumps(rep, indent=2) + "\n")
+    return rep
+
+
 def run(case: str, sim: str) -> dict:
+    if case in SMALL:
+        return run_small(case, sim)
     block, extra = CASES[case]
     params = dict(HW, **extra)
     sp = spacing(params["disparities"], params["pu"])
@@ -62,6 +102,8 @@ def kept(case: str, sim: str) -> dict | None:
 
 
 def report(runs: list[dict]) -> str:
+    small = [r for r in runs if r["case"] in SMALL]
+    runs = [r for r in runs if r["case"] not in SMALL]
     rows = []
     for r in runs:
         sp = r["spacing"]
@@ -75,6 +117,15 @@ def report(runs: list[dict]) -> str:
     out += markdown_table(["case", "simulator", "PU", "bit-exact", "pixels", "valid codes", "clocks / pixel",
                            "clocks, first input to last code", "fps the spacing allows at 100 MHz",
                            "row lag (clocks after its last pixel)", "wall (s)"], rows)
+    if small:
+        out += ["", f"The blocks around sgm on their own, the same {WIDTH} x {HEIGHT} frame: census on the grey "
+                "pair (both cameras' words compared), median3 on the model's codes of census + SGM without the "
+                "median; input at 0.7 beats per clock with random gaps; every output compared with the model, "
+                "and the latency of every pixel whose window is complete.", ""]
+        out += markdown_table(["case", "simulator", "bit-exact", "words compared", "latency (clocks)",
+                               "pixels with the latency checked", "wall (s)"],
+                              [[r["case"], r["sim"], "yes", r["pixels_compared"], r["latency"], r["latency_checked"],
+                                f"{r['wall']:.0f}"] for r in small])
     return "\n".join(out) + "\n\n"
 
 

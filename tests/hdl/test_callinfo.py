@@ -12,7 +12,7 @@ from eyestereo.hdl.common import callinfo
 # Blocks whose elaboration covers the ways MyHDL finds callers: plain blocks, blocks made in list
 # comprehensions (line delays of the window machinery), @instance and @always_seq generators, sub-blocks
 # in several levels (harris_mono, rectifier), interfaces and memories.
-BLOCKS = ("sobel", "harris_mono", "rectifier", "sram_subsystem", "camera_interface")
+BLOCKS = ("sobel", "harris_mono", "rectifier", "camera_interface")
 
 _SCRIPT = textwrap.dedent("""
     import sys

@@ -106,3 +106,22 @@ def test_median3_converts_and_analyses(tmp_path):
     v = convert("median3", tmp_path / "verilog", hdl="Verilog")
     check_verilog(v, "median3", tmp_path / "icarus")
     assert not mixed_signedness(v[0].read_text())
+
+
+def test_a_saved_code_map_is_cropped_at_its_bottom_right(tmp_path):
+    """``npy:FILE`` (bench_dense's full-frame median3 case): the bottom-right width x height of the saved map;
+    an array too small, or not 2-D, is one clear error naming the file."""
+    import numpy as np
+
+    from eyestereo.sim.benches.tb_median3 import codes
+
+    m = np.arange(6 * 8).reshape(6, 8)
+    f = tmp_path / "codes.npy"
+    np.save(f, m)
+    assert codes(f"npy:{f}", 3, 2).tolist() == [[37, 38, 39], [45, 46, 47]]
+    assert codes(f"npy:{f}", 8, 6).tolist() == m.tolist()
+    with pytest.raises(ValueError, match=r"codes.npy: a \(6, 8\) array holds no 6 x 9 code map"):
+        codes(f"npy:{f}", 9, 6)
+    np.save(f, np.zeros(5))
+    with pytest.raises(ValueError, match="holds no"):
+        codes(f"npy:{f}", 1, 1)

@@ -26,7 +26,10 @@ from eyestereo.tools.models import stereo_frontend as model
 
 SPEC = "rig:32x24"
 W, H = 32, 24
-FRAMES = {"sequential": 3, "overlapped": 3}
+#: the dense option's frames: small (rows wider than D = 16), GHDL simulating the front end with the dense core at
+#: about a thousand memory clocks a second
+DENSE_SPEC = "rig:24x16"
+FRAMES = {"sequential": 2, "overlapped": 2}  # two frames: the pairs move on, the thresholds change
 TIMING = dict(h_blank=8, v_sync=1, v_back=1, v_front=1)
 
 
@@ -287,16 +290,16 @@ def test_stereo_frontend_dense(request, mode, rectify, sim):
     d, pu = 16, 4
     settings = dict(p1=8, p2=40, uniqueness=15, subpixel=0)
     rep = run_bench("stereo_frontend", "tb_stereo_frontend",
-                    dict(mode=mode, frames=3, images="shift:3", timing=TIMING, require_features=False, pause=0.0,
+                    dict(mode=mode, frames=2, images="shift:3", timing=TIMING, require_features=False, pause=0.0,
                          adaptive=None, dense_settings=settings, backdoor_rect=sim == "ghdl"),
                     name=request.node.name, sim=sim, backend=runner.fastest_ghdl_backend() if sim == "ghdl" else None,
-                    params=dict(quantizers=SPEC, feature_words=256, max_features=127, rectify=rectify, dense=True,
+                    params=dict(quantizers=DENSE_SPEC, feature_words=256, max_features=127, rectify=rectify, dense=True,
                                 disparities=d, pu=pu))
-    assert rep["bit_exact"] and len(rep["frames"]) == 3
+    assert rep["bit_exact"] and len(rep["frames"]) == 2
     assert rep["dense"]["p2"] == 40 and rep["dense"]["subpixel"] is False and rep["dense"]["disparities"] == d
     disp = [tuple(f["disp_pair"]) for f in rep["frames"]]
-    assert disp == sorted(disp) and len(set(disp)) == 3, disp
-    assert rep["disp_frames"] >= 3
+    assert disp == sorted(disp) and len(set(disp)) == 2, disp
+    assert rep["disp_frames"] >= 2
 
 
 def test_dense_option_parameters_are_checked():
