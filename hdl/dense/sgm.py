@@ -95,7 +95,7 @@ def sgm(clk, rst, sink, source, p1, p2, uniqueness, lr_check, subpixel, overrun,
 
     Latency: a pixel every :func:`spacing` clocks (D = 64, PU = 4: 18; 54.8 frames/s of 352 x 288 at
     100 MHz). A row's codes start once its last pixel's result is written and follow one per clock: on a
-    full 352 x 288 Tsukuba frame, 72 to 201 clocks after the row's last input pixel (the FIFO's backlog;
+    full 352 x 288 Tsukuba frame, 73 to 202 clocks after the row's last input pixel (the FIFO's backlog;
     docs/dense.md, "Full frames").
 
     Resources: per path after the first, a ring of ``2**ceil(log2(width + 1)) x 2**ceil(log2(D / PU))``
@@ -603,7 +603,7 @@ def lane_counter(clk, load, step, last, x, xk, *, k: int, pu: int, mm: int):
 def cost_lane(clk, we, wa, wd, xm, cl, cand4, cost, *, k: int, pu: int, rr: int, mm: int, cmax: int):
     """Lane k: its copy of the right census ring, read at (x - d0 - k) mod rr (stage 0: ``xm``, the lane's own
     counter, so no subtraction comes before the RAM's address), registered twice
-    (stages 1, 2), the Hamming distance to the left word in 6-bit chunks (stage 3) and their sum (stage 4),
+    (stages 1, 2), the Hamming distance to the left word in 3-bit chunks (stage 3) and their sum (stage 4),
     saturated at cmax, and cmax for a non-candidate (stage 5)."""
     nbits = len(wd)
     census_norw = [Signal(intbv(0)[nbits:]) for _ in range(rr)]
@@ -611,7 +611,11 @@ def cost_lane(clk, we, wa, wd, xm, cl, cand4, cost, *, k: int, pu: int, rr: int,
     ra = Signal(intbv(0)[rb:])
     q = Signal(intbv(0)[nbits:])
     qr = Signal(intbv(0)[nbits:])
-    chunk = 6
+    # 3-bit chunks: each count bit a function of 6 inputs (two LUT levels), so that the register after the RAM's
+    # (qr) feeds shallow logic and make synth's bram_regs moves it into the block RAM's output register; 6-bit
+    # chunks were deeper, qr stayed a slice flip-flop, and RAM -> qr (5.8 ns of clock-to-out, then the route)
+    # was the dense front end's slowest memory-clock path (109.8 MHz)
+    chunk = 3
     nch = (nbits + chunk - 1) // chunk
     total = Signal(intbv(0, min=0, max=nbits + 1))
     ok4 = Signal(bool(0))
@@ -763,7 +767,10 @@ def path(clk, clr, bv, bg, rpos, start, first3, last3, v7, first7, last7, g7, po
         # a power of two of words (the place's bits, then the group's): each block RAM then holds a slice of
         # every word at the full address (ECP5: 8K x 2), with no address decoder before the RAMs and no
         # multiplexer after them -- both were the slowest paths when the ring took only ring x npw words
-        ring_norw = [Signal(intbv(0)[ww:]) for _ in range(1 << (len(pos7) + len(g7)))]
+        # _oreg: the register after it (w2) goes into the block RAM's output register although the last lane's
+        # "+ P1" reads it (flow/bram_regs.py): as a slice flip-flop, RAM -> w2 was the dense front end's slowest
+        # memory-clock path (105.9 MHz)
+        ring_oreg_norw = [Signal(intbv(0)[ww:]) for _ in range(1 << (len(pos7) + len(g7)))]
         mins_norw = [Signal(intbv(0)[pb:]) for _ in range(ring)]
         mq, mr = Signal(intbv(0)[pb:]), Signal(intbv(0)[pb:])
         posw = _like(pos7)
@@ -774,8 +781,8 @@ def path(clk, clr, bv, bg, rpos, start, first3, last3, v7, first7, last7, g7, po
         @always(clk.posedge)
         def ring_ram():
             if v7:
-                ring_norw[concat(pos7, g7)].next = word
-            q.next = ring_norw[concat(rpos, bg)]
+                ring_oreg_norw[concat(pos7, g7)].next = word
+            q.next = ring_oreg_norw[concat(rpos, bg)]
 
         @always(clk.posedge)
         def min_write():

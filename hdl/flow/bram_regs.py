@@ -25,6 +25,11 @@ register, block RAM or port crosses at most :data:`MAX_LEVELS` cells (a LUT, a m
 unregistered multiplier or a LUT-RAM read counting one): the line cache's bank select (issue 26) qualifies,
 the filters' line delays do not.
 
+A memory named with ``_oreg`` (for instance ``ring_oreg_norw``) moves its registers whatever the logic after
+them: the block asks for it where that logic is a short carry chain which the levels overcount and the route out
+of the block RAM, not the logic, is what limits the clock (sgm's path rings: a lane's word into the next lane's
+``+ P1``, a 9-bit chain, five cells).
+
 A memory that Yosys guarded with a read/write collision LUT (a write and a read of one address in one clock)
 is not matched, since the LUT, not a flip-flop, reads the data: such memories can be named ``*_norw`` so
 that ``no_rw_check`` (:func:`eyestereo.hdl.flow.netlist.mark_no_rw_check`) lets Yosys leave the LUT out when
@@ -42,6 +47,8 @@ BRAM = "DP16KD"
 DO_BITS = 18
 #: The deepest logic (cells) after a register that may move into its block RAM.
 MAX_LEVELS = 3
+#: In a memory's name: move its registers whatever the depth after them (the module docstring).
+OREG = "_oreg"
 
 
 def _is_endpoint(cell: dict) -> bool:
@@ -81,8 +88,9 @@ def _levels(net, cells: dict, loads: dict, budget: int, memo: dict) -> int:
     return min(deepest, budget + 1)
 
 
-def _port_plan(ram: dict, port: str, cells: dict, loads: dict) -> tuple | None:
-    """(enable, {bit: FF name}) when port ``port``'s used outputs each feed one plain FF on its clock; else None."""
+def _port_plan(ram: dict, port: str, cells: dict, loads: dict, *, any_depth: bool = False) -> tuple | None:
+    """(enable, {bit: FF name}) when port ``port``'s used outputs each feed one plain FF on its clock; else None.
+    ``any_depth``: skip the check of the logic after the flip-flops (a memory named with :data:`OREG`)."""
     par, conn = ram["parameters"], ram["connections"]
     if par.get(f"REGMODE_{port}", "NOREG").strip() != "NOREG" or conn.get(f"RST{port}", ["0"]) != ["0"]:
         return None
@@ -107,7 +115,7 @@ def _port_plan(ram: dict, port: str, cells: dict, loads: dict) -> tuple | None:
     if not ffs:
         return None
     memo: dict = {}
-    if any(_levels(cells[ff]["connections"]["Q"][0], cells, loads, MAX_LEVELS, memo) > MAX_LEVELS
+    if not any_depth and any(_levels(cells[ff]["connections"]["Q"][0], cells, loads, MAX_LEVELS, memo) > MAX_LEVELS
            for ff in ffs.values()):
         return None  # deep logic after the register: it stays a slice flip-flop, next to that logic
     return enable, ffs
@@ -125,7 +133,7 @@ def pack_bram_registers(netlist: dict, top: str) -> dict:
         if ram is None or ram["type"] != BRAM:
             continue
         for port in ("A", "B"):
-            plan = _port_plan(ram, port, cells, loads)
+            plan = _port_plan(ram, port, cells, loads, any_depth=OREG in name)
             if plan is None:
                 continue
             enable, ffs = plan

@@ -70,7 +70,7 @@ def run_small(case: str, sim: str) -> dict:
         rep = run_bench("census", "tb_census", dict(frames=[pair], duty=0.7, seed=1), name="measure_census",
                         params=dict(window=HW["window"], width=WIDTH, height=HEIGHT, stereo=True), sim=sim)
     else:
-        rep = run_bench("median3", "tb_median3", dict(frames=[f"npy:{codes_file()}"], duty=0.7, seed=1),
+        rep = run_bench("median3", "tb_median3", dict(frames=[f"npy:{codes_file().resolve()}"], duty=0.7, seed=1),
                         name="measure_median3", params=dict(width=WIDTH, height=HEIGHT), sim=sim)
     rep.update(wall=time.time() - t0, case=case, sim=f"ghdl ({ghdl_backend()})" if sim == "ghdl" else sim)
     RUNS.mkdir(parents=True, exist_ok=True)

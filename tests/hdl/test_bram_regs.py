@@ -99,3 +99,18 @@ def test_deep_logic_after_the_register_keeps_it_in_a_slice():
     n = _design(chain=MAX_LEVELS)
     before = copy.deepcopy(n)
     assert pack_bram_registers(n, "top")["ports"] == 0 and n == before
+
+
+def test_a_memory_named_oreg_moves_its_register_over_deep_logic():
+    """``_oreg`` in the memory's name (sgm's path rings): the register moves whatever follows it; the other
+    conditions still hold (a reset keeps it in a slice)."""
+    n = _design(chain=MAX_LEVELS + 3)
+    cells = n["modules"]["top"]["cells"]
+    cells["path1_ring_oreg_norw.0.2"] = cells.pop("ram")
+    assert pack_bram_registers(n, "top") == dict(ports=1, ffs_removed=4)
+    assert cells["path1_ring_oreg_norw.0.2"]["parameters"]["REGMODE_B"] == "OUTREG"
+    n = _design(chain=MAX_LEVELS + 3, lsr=RST)
+    cells = n["modules"]["top"]["cells"]
+    cells["path1_ring_oreg_norw.0.2"] = cells.pop("ram")
+    before = copy.deepcopy(n)
+    assert pack_bram_registers(n, "top")["ports"] == 0 and n == before
