@@ -83,18 +83,18 @@ def test_stereo_frontend_stream_more(request, mode, memory):
 def stream_run(request, mode, memory, sim=None):
     extra = dict(memory="sdram", sdram_part="AS4C32M16SB-7:powerup_us=1") if memory == "sdram" else {}
     rep = run_bench("stereo_frontend", "tb_stereo_frontend",
-                    dict(mode=mode, frames=3, images="shift:3", timing=TIMING, require_features=True, pause=0.0,
+                    dict(mode=mode, frames=2, images="shift:3", timing=TIMING, require_features=True, pause=0.0,
                          adaptive=None, backdoor_rect=memory == "sram"),  # SDRAM: the pairs through the host
                     name=request.node.name, sim=sim, params=dict(quantizers=SPEC, feature_words=256,
                                                                  max_features=127, rectify="stream", **extra))
-    assert rep["bit_exact"] and len(rep["frames"]) == 3
+    assert rep["bit_exact"] and len(rep["frames"]) == 2
     if memory == "sdram":  # the bench asserted no rule broken; refreshes ran (tREFI 7.8 us) and none was late
         assert rep["sdram"]["refreshes"] > 20 and rep["sdram"]["late_refreshes"] == 0
     pairs = [tuple(f["rect_pair"]) for f in rep["frames"]]
-    assert pairs == sorted(pairs) and len(set(pairs)) == 3
+    assert pairs == sorted(pairs) and len(set(pairs)) == 2
     arb = rep["arb"]
     assert arb["moved_cam0"] == arb["moved_cam1"] == arb["moved_fetch"] == 0  # 0 memory reads to rectify
-    assert arb["moved_rect"] >= 3 * W * H and arb["moved_feat"] > 0
+    assert arb["moved_rect"] >= 2 * W * H and arb["moved_feat"] > 0
 
 
 @pytest.mark.sim
@@ -204,7 +204,8 @@ def test_stereo_frontend_flat_scene_without_corners(request, tmp_path):
     for f in files:
         np.save(f, grey)
     rep = run_bench("stereo_frontend", "tb_stereo_frontend",
-                    dict(mode="overlapped", frames=2, pair=[str(f) for f in files], timing=TIMING),
+                    dict(mode="overlapped", frames=2, pair=[str(f) for f in files], timing=TIMING,
+                         backdoor_rect=True),  # the lists (a trailer each) through the host port
                     name=request.node.name, sim=fastest_simulator(), public=_public(),
                     params=dict(quantizers=SPEC, feature_words=256, max_features=127))
     assert rep["bit_exact"] and len(rep["frames"]) == 2
