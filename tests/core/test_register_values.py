@@ -180,10 +180,12 @@ def test_the_model_refuses_the_frame_sizes_the_block_refuses(kw):
 
 
 def test_the_frame_size_messages():
-    refused(lambda: RegisterBank(width=1), "parameter width=1 is too small: the bank takes 2..4096")
-    refused(lambda: RegisterBank(height=4097), "parameter height=4097 is too large: the bank takes 2..4096")
-    refused(lambda: RegisterBank(width=8.0),
-            "parameter width must be an integer, got float 8.0 (the bank takes 2..4096)")
+    # refused() asserts the exception and its exact one-line message; the messages name what was refused
+    errors = [refused(lambda: RegisterBank(width=1), "parameter width=1 is too small: the bank takes 2..4096"),
+              refused(lambda: RegisterBank(height=4097), "parameter height=4097 is too large: the bank takes 2..4096"),
+              refused(lambda: RegisterBank(width=8.0),
+                      "parameter width must be an integer, got float 8.0 (the bank takes 2..4096)")]
+    assert [str(e).split()[1].split("=")[0] for e in errors] == ["width", "height", "width"]
 
 
 @pytest.mark.parametrize("kw", [dict(width=FRAME_MIN, height=FRAME_MIN), dict(width=FRAME_MAX, height=FRAME_MAX),
