@@ -1,5 +1,5 @@
 """MyHDL blocks, in rooms by family (docs/architecture.md): interfaces, common, streaming, harris, rectify,
-camera, memory, axi, system; the EDA flow in ``flow`` (it imports the blocks, no block imports it).
+camera, memory, axi, dense, matching, system; the EDA flow in ``flow`` (it imports the blocks, no block imports it).
 
 The public blocks and port bundles are re-exported here, so a user's import stays short::
 
@@ -32,6 +32,7 @@ _EXPORTS = {
     "sgm": "dense.sgm",
     "median3": "dense.median3",
     "dense_stereo": "dense.dense_stereo",
+    "match_engine": "matching.match_engine",
     "harris_mono": "harris.harris_mono",
     "harris_stereo": "harris.harris_stereo",
     "feature_list": "harris.feature_list",
@@ -63,6 +64,7 @@ _EXPORTS = {
     "CameraBus": "interfaces.camera_bus",
     "AxiLite": "interfaces.axil",
     "AxiStream": "interfaces.axis",
+    "DescriptorPort": "interfaces.descriptor",
     "SramPins": "interfaces.sram_bus",
     "SramCmd": "interfaces.sram_bus",
     "SramRsp": "interfaces.sram_bus",

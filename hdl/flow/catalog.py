@@ -33,6 +33,9 @@ from eyestereo.hdl.dense.census import census
 from eyestereo.hdl.dense.median3 import median3
 from eyestereo.hdl.dense.sgm import sgm
 from eyestereo.hdl.dense.dense_stereo import dense_stereo
+from eyestereo.hdl.interfaces.descriptor import DescriptorPort
+from eyestereo.hdl.matching.match_engine import limit_bits, match_engine
+from eyestereo.tools.models.match_engine import word_bits as match_word_bits
 from eyestereo.hdl.harris.cornerness import cornerness
 from eyestereo.hdl.harris.harris_mono import harris_mono
 from eyestereo.hdl.harris.harris_stereo import harris_stereo
@@ -302,6 +305,14 @@ def _build_dense_stereo(p):
     return fresh_ports(dense_stereo, sink=ImageStream(8, stereo=True), source=ImageStream(16), **_dense_settings())
 
 
+def _build_match_engine(p):
+    # the descriptor port of the cost's words, the 16-bit list port, the run-time settings and the flag
+    return fresh_ports(match_engine, sink=DescriptorPort(match_word_bits(p["cost"], p["window"]), width=p["width"],
+                                                         height=p["height"]),
+                       source=QueuePort(16), limit=Signal(intbv(0)[limit_bits():]), uniqueness=Signal(intbv(0)[7:]),
+                       lr_check=Signal(bool(0)), dropped=Signal(bool(0)))
+
+
 def _build_coordinate_warper(p):
     cal = calibration(p)
     return fresh_ports(coordinate_warper, start=_bit(p), enable=_bit(p), busy=_bit(p), done=_bit(p),
@@ -384,6 +395,9 @@ BLOCKS: dict[str, BlockSpec] = {b.name: b for b in (
           "left-right check, sub-pixel; 16-bit codes", sgm, build=_build_sgm),
     block("dense_stereo", "census, sgm and the 3x3 median: a rectified stereo stream in, disparity codes out",
           dense_stereo, build=_build_dense_stereo),
+    block("match_engine", "corner descriptors of both cameras -> the frame's match list: candidates in a disparity "
+          "range and +-R rows, SAD or census costs, best and second best, threshold, uniqueness, left-right check",
+          match_engine, build=_build_match_engine),
     block("median3", "3x3 median of 16-bit disparity codes (0xFFFF = invalid, the largest), border pixels passed "
           "through", median3, sink_width=_fixed(16), source_width=_fixed(16)),
     block("poly_unit", "the four rectification polynomials, 8-stage pipeline, 9 multipliers, 1 coordinate/clock",

@@ -37,6 +37,7 @@ BUNDLES = (
     ("camera_bus", "CameraBus", "camera", "FPGA", {}),
     ("axil", "AxiLite", "master", "slave (register bank)", {}),
     ("axis", "AxiStream", "master", "slave", dict(data_width=8)),
+    ("descriptor", "DescriptorPort", "descriptor stage", "match engine", dict(data_width=24)),
     # bundles that live beside the block they belong to (a room path instead of an interfaces module)
     ("memory.frame_buffers", "FrameControl", "controller (system)", "SRAM arbiter", {}),
     ("memory.frame_buffers", "BufferSide", "writer / reader", "double_buffer", {}),

@@ -46,7 +46,7 @@ FORBIDDEN = {
 TOOLS = {"tools/core", "tools/models", "tools/rectify", "tools/matching", "tools/dense", "tools/cli", "tools/reports"}
 #: The rooms of hdl that hold blocks (and the port bundles and helpers they are made of).
 BLOCKS = {f"hdl/{r}" for r in ("interfaces", "common", "streaming", "harris", "rectify", "camera", "memory", "axi",
-                                 "dense")}
+                                 "dense", "matching")}
 #: All of hdl: the block rooms, the top, the EDA flow and the package itself (``eyestereo.hdl``, which
 #: re-exports the blocks).
 HDL = BLOCKS | {"hdl/system", "hdl/flow", "hdl"}
@@ -72,8 +72,10 @@ ROOMS = {
     "hdl/camera": TOOLS | {"hdl/common", "hdl/interfaces", "hdl/streaming"},
     "hdl/memory": TOOLS | {"hdl/common", "hdl/interfaces"},
     "hdl/axi": TOOLS | {"hdl/common", "hdl/interfaces"},
-    # dense stereo (issue 28): census (and the matching blocks to come) on the library's window machinery
+    # dense stereo (issue 28): census on the library's window machinery
     "hdl/dense": TOOLS | {"hdl/common", "hdl/interfaces", "hdl/streaming"},
+    # the hardware feature matcher (issue 29): the engine; its front half will take the census from dense
+    "hdl/matching": TOOLS | {"hdl/common", "hdl/interfaces", "hdl/streaming", "hdl/dense"},
     "hdl/system": TOOLS | BLOCKS,
     "hdl/flow": TOOLS | BLOCKS | {"hdl/system"},
     "hdl": TOOLS | BLOCKS | {"hdl/system"},
@@ -95,6 +97,7 @@ TIERS = [
     {"hdl/interfaces", "hdl/common"},
     {"hdl/streaming"},
     {"hdl/harris", "hdl/rectify", "hdl/camera", "hdl/memory", "hdl/axi", "hdl/dense"},
+    {"hdl/matching"},
     {"hdl/system"},
     {"hdl/flow", "hdl"},
     {"sim", "sim/lib", "sim/harnesses"},

@@ -1,4 +1,4 @@
-"""Bit-true model of the future ``feature_matcher`` block (issue 29): Harris corners of both cameras to matches.
+"""Bit-true model of the ``feature_matcher`` block (issue 29): Harris corners of both cameras to matches.
 
 The block takes the two feature lists of a frame (:mod:`eyestereo.tools.models.feature_list`, raster
 order) and the rectified pixels around every corner, and writes one match list per frame. Everything is
@@ -35,18 +35,21 @@ integer; the steps:
 7. **List**: the matches in the order of their left corners, at most ``max_matches``; the rest are
    counted (``total``), not listed, and the trailer's overflow flag is set (as the feature list does).
 
+Steps 1 and 3-7 are :func:`~eyestereo.tools.models.match_engine.match_engine`, the model of the block's
+second half, on the corners' descriptors (:func:`descriptors`: the window's grey levels or its census bits).
+
 Per left corner ``status`` says what became of it: :data:`MATCHED`, :data:`NO_CANDIDATE`,
 :data:`OVER_THRESHOLD`, :data:`NOT_UNIQUE`, :data:`LR_FAILED` (the first test it failed, in that order).
 
-**The words** (the match writer's queue port of 16-bit words, like the feature list's, and the host
-driver's), declared once here: a match is one :data:`MATCH` word of 48 bits, three queue words, low
-first: bits 11..0 x, 15..12 dy = yr - yl (signed), 27..16 y, 35..28 disparity, 47..36 cost. Widths from
-the parameter ranges: x and y 12 bits (frames up to :data:`~eyestereo.tools.constants.FRAME_MAX` = 4096),
-dy 4 bits signed (rows <= 7), disparity 8 bits (d_max <= 255), cost 12 bits because only accepted
-matches are listed and the limit is at most 4096 (t_max * window**2 <= 4096: t_max up to 33 with 11 x 11,
-163 with 5 x 5, the thesis uses 11; census costs are at most 120). The list ends with one
-:data:`TRAILER` (three words): :data:`MARKER` (0x8000: dy = -8, which no match has), then the count
-(bits 14..0) with the overflow flag (bit 15), then ``candidates`` saturated at 0xFFFF; ``eol`` and
+**The words** (the match writer's queue port of 16-bit words, like the feature list's, and the host driver's),
+declared once in :mod:`~eyestereo.tools.models.match_engine`: a match is one :data:`MATCH` word of 48 bits,
+three queue words, low first: bits 11..0 x, 15..12 dy = yr - yl (signed), 27..16 y, 35..28 disparity, 47..36
+cost. Widths from the parameter ranges: x and y 12 bits (frames up to
+:data:`~eyestereo.tools.constants.FRAME_MAX` = 4096), dy 4 bits signed (rows <= 7), disparity 8 bits (d_max <=
+255), cost 12 bits because only accepted matches are listed and the limit is at most 4096 (t_max * window**2
+<= 4096: t_max up to 33 with 11 x 11, 163 with 5 x 5, the thesis uses 11; census costs are at most 120). The
+list ends with one :data:`TRAILER` (three words): :data:`MARKER` (0x8000: dy = -8, which no match has), then
+the count (bits 14..0) with the overflow flag (bit 15), then ``candidates`` saturated at 0xFFFF; ``eol`` and
 ``eof`` on its last word.
 
 **Differences from** :func:`eyestereo.tools.matching.sparse.match_features`, which this model equals for
@@ -63,32 +66,14 @@ from __future__ import annotations
 import numpy as np
 
 from eyestereo.tools.constants import FRAME_MAX, FRAME_MIN
-from eyestereo.tools.fixed import sfix, ufix
 from eyestereo.tools.models.census import check_image
-from eyestereo.tools.packed import PackedWord
+from eyestereo.tools.models.match_engine import (COSTS, LR_FAILED, MARKER, MATCH, MATCHED, MAX_DISPARITY, MAX_LIMIT,
+                                                 MAX_MATCHES, MAX_ROWS, NO_CANDIDATE, NOT_UNIQUE, OVER_THRESHOLD,
+                                                 TRAILER, WINDOWS, candidates, check_engine, match_engine)
 
 __all__ = ["COSTS", "WINDOWS", "MATCH", "TRAILER", "MARKER", "MAX_MATCHES", "MAX_ROWS", "MAX_DISPARITY",
            "MAX_LIMIT", "MATCHED", "NO_CANDIDATE", "OVER_THRESHOLD", "NOT_UNIQUE", "LR_FAILED", "check_params",
-           "cost_limit", "candidates", "feature_matcher"]
-
-COSTS = ("sad", "census")
-#: The window sizes the block offers (odd, so the corner is the centre).
-WINDOWS = (5, 7, 9, 11)
-#: One match: three 16-bit queue words, low first (see the module docstring).
-MATCH = PackedWord("match", [("x", ufix(12)), ("dy", sfix(4)), ("y", ufix(12)), ("disparity", ufix(8)),
-                             ("cost", ufix(12))])
-#: The end of a frame's list: MARKER, then count | overflow << 15, then the candidates (saturated).
-TRAILER = PackedWord("match list trailer", [("marker", ufix(16)), ("count", ufix(15)), ("overflow", ufix(1)),
-                                            ("candidates", ufix(16))])
-MARKER = 0x8000
-MAX_MATCHES = (1 << 15) - 1
-MAX_ROWS = 7
-MAX_DISPARITY = 255
-#: The largest threshold: the listed costs must fit MATCH's 12-bit cost field.
-MAX_LIMIT = 1 << 12
-#: What became of a left corner (``status``).
-MATCHED, NO_CANDIDATE, OVER_THRESHOLD, NOT_UNIQUE, LR_FAILED = range(5)
-_CHUNK = 1 << 21  # pixel differences per chunk of pairs (memory bound, a few MB)
+           "cost_limit", "candidates", "descriptors", "feature_matcher"]
 
 
 def _int(value, name: str) -> int:
@@ -118,23 +103,8 @@ def check_params(*, window: int, cost: str, t_max: int, h_max: int, d_min: int, 
                          f"{window} SAD window (t_max * window**2 <= {MAX_LIMIT}: the 12-bit cost field)")
     if cost == "census" and not 1 <= h_max <= 100:
         raise ValueError(f"parameter h_max={h_max}: must be 1..100 (percent of the census bits)")
-    d_min, d_max = _int(d_min, "d_min"), _int(d_max, "d_max")
-    if d_min < 0:
-        raise ValueError(f"parameter d_min={d_min}: must be >= 0 (d = xl - xr; negative disparities lie "
-                         f"behind the cameras)")
-    if d_max > MAX_DISPARITY:
-        raise ValueError(f"parameter d_max={d_max}: must be <= {MAX_DISPARITY} (8-bit disparity field)")
-    if d_min > d_max:
-        raise ValueError(f"parameters d_min={d_min}, d_max={d_max}: the disparity range is empty")
-    rows = _int(rows, "rows")
-    if not 0 <= rows <= MAX_ROWS:
-        raise ValueError(f"parameter rows={rows}: must be 0..{MAX_ROWS} (4-bit signed dy field)")
-    uniqueness = _int(uniqueness, "uniqueness")
-    if not 0 <= uniqueness <= 99:
-        raise ValueError(f"parameter uniqueness={uniqueness}: must be 0..99 (percent; 0 = off)")
-    max_matches = _int(max_matches, "max_matches")
-    if not 1 <= max_matches <= MAX_MATCHES:
-        raise ValueError(f"parameter max_matches={max_matches}: must be 1..{MAX_MATCHES} (15-bit count)")
+    check_engine(cost=cost, window=window, limit=cost_limit(cost, window, t_max, h_max), d_min=d_min, d_max=d_max,
+                 rows=rows, uniqueness=uniqueness, max_matches=max_matches)
 
 
 def _check_features(xy, shape, what: str) -> np.ndarray:
@@ -153,24 +123,6 @@ def _check_features(xy, shape, what: str) -> np.ndarray:
     if np.any(np.diff(key) <= 0):
         raise ValueError(f"{what} must be in raster order without repeats (the feature list's order)")
     return a
-
-
-def candidates(left_xy: np.ndarray, right_xy: np.ndarray, width: int, d_min: int, d_max: int,
-               rows: int) -> tuple[np.ndarray, np.ndarray]:
-    """(left index, right index) of every pair, in the block's order (checked, raster-ordered lists)."""
-    keys = right_xy[:, 1] * width + right_xy[:, 0]  # increasing: the right list is in raster order
-    dys = np.arange(-rows, rows + 1)
-    y = left_xy[:, 1:2] + dys[None, :]  # (n, 2 rows + 1): one key range per row, row yl - rows first
-    xlo = np.maximum(left_xy[:, 0] - d_max, 0)[:, None]
-    xhi = np.minimum(left_xy[:, 0] - d_min, width - 1)[:, None]
-    start = np.searchsorted(keys, y * width + xlo, side="left")
-    stop = np.searchsorted(keys, y * width + xhi, side="right")
-    cnt = np.where(xlo <= xhi, stop - start, 0).ravel()  # rows off the image find no key: empty ranges
-    total = int(cnt.sum())
-    first = np.repeat(np.cumsum(cnt) - cnt, cnt)
-    ri = np.repeat(start.ravel(), cnt) + (np.arange(total) - first)
-    li = np.repeat(np.repeat(np.arange(len(left_xy)), len(dys)), cnt)
-    return li.astype(np.int64), ri.astype(np.int64)
 
 
 def _windows(pad: np.ndarray, xy: np.ndarray, r: int) -> np.ndarray:
@@ -193,23 +145,11 @@ def _census_words(img: np.ndarray, xy: np.ndarray, r: int) -> np.ndarray:
     return np.delete(win < win[:, centre:centre + 1], centre, axis=1)
 
 
-def _pair_costs(a: np.ndarray, b: np.ndarray, li: np.ndarray, ri: np.ndarray, cost: str) -> np.ndarray:
-    out = np.empty(len(li), np.int64)
-    step = max(1, _CHUNK // max(1, a.shape[1]))
-    for s in range(0, len(li), step):
-        pa, pb = a[li[s:s + step]], b[ri[s:s + step]]
-        diff = np.abs(pa - pb) if cost == "sad" else pa != pb
-        out[s:s + step] = diff.sum(axis=1, dtype=np.int64)
-    return out
-
-
-def _first_of_groups(keys: tuple, group: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Pairs sorted by group, then by ``keys`` (most significant first); the start of each group in it."""
-    order = np.lexsort(tuple(reversed(keys)) + (group,))
-    g = group[order]
-    first = np.ones(len(order), bool)
-    first[1:] = g[1:] != g[:-1]
-    return order, first
+def descriptors(img: np.ndarray, xy: np.ndarray, cost: str, window: int) -> np.ndarray:
+    """The corners' descriptors the engine compares (:mod:`eyestereo.tools.models.match_engine`): (n, window**2)
+    grey levels, edge pixels repeated past the border (SAD), or (n, window**2 - 1) census bits (census)."""
+    r = window // 2
+    return _sad_windows(img, xy, r) if cost == "sad" else _census_words(img, xy, r)
 
 
 def feature_matcher(left, right, left_xy, right_xy, *, window: int = 9, cost: str = "sad", t_max: int = 11,
@@ -243,61 +183,6 @@ def feature_matcher(left, right, left_xy, right_xy, *, window: int = 9, cost: st
     fl = _check_features(left_xy, left.shape, "left features")
     fr = _check_features(right_xy, right.shape, "right features")
     limit = cost_limit(cost, window, int(t_max), int(h_max))
-    nl = len(fl)
-
-    li, ri = candidates(fl, fr, w, int(d_min), int(d_max), int(rows))
-    r = window // 2
-    if cost == "sad":
-        a, b = _sad_windows(left, fl, r), _sad_windows(right, fr, r)
-    else:
-        a, b = _census_words(left, fl, r), _census_words(right, fr, r)
-    c = _pair_costs(a, b, li, ri, cost)
-    dyr = fr[ri, 1] - fl[li, 1]
-    disp = fl[li, 0] - fr[ri, 0]
-    keys = (c, np.abs(dyr), disp, dyr)  # the order of the pairs of one corner: cost, then the ties
-
-    best = np.full(nl, -1, np.int64)
-    second = np.full(nl, -1, np.int64)
-    choice = np.full(nl, -1, np.int64)
-    status = np.full(nl, NO_CANDIDATE, np.int64)
-    if len(li):
-        order, first = _first_of_groups(keys, li)
-        win = order[first]
-        best[li[win]], choice[li[win]] = c[win], ri[win]
-        # the pair after a group's first, when in the same group, holds its second-lowest cost
-        nxt = np.flatnonzero(first) + 1
-        nxt = nxt[nxt < len(order)]
-        nxt = nxt[li[order[nxt]] == li[order[nxt - 1]]]
-        second[li[order[nxt]]] = c[order[nxt]]
-        has = choice >= 0
-        status[has] = MATCHED
-        status[has & (best >= limit)] = OVER_THRESHOLD
-        unique = (second < 0) | (best * (100 + int(uniqueness)) <= second * 100)
-        status[(status == MATCHED) & ~unique] = NOT_UNIQUE
-        if lr_check:
-            # the right corner's best left corner, over all its pairs: if that best is over the
-            # threshold, so are all its pairs, and no left corner can be matched to it anyway
-            order_r, first_r = _first_of_groups(keys, ri)
-            best_left = np.full(len(fr), -1, np.int64)
-            best_left[ri[order_r[first_r]]] = li[order_r[first_r]]
-            mutual = np.zeros(nl, bool)
-            mutual[has] = best_left[choice[has]] == np.flatnonzero(has)
-            status[(status == MATCHED) & ~mutual] = LR_FAILED
-
-    found = np.flatnonzero(status == MATCHED)  # increasing: the order of the left corners
-    listed = found[:max_matches]
-    j = choice[listed]
-    matches = np.stack([fl[listed, 0], fl[listed, 1], fl[listed, 0] - fr[j, 0], best[listed]], axis=1)
-    dy = fr[j, 1] - fl[listed, 1]
-    overflow = len(found) > max_matches
-    words = []
-    packed = MATCH.pack(x=matches[:, 0], dy=dy, y=matches[:, 1], disparity=matches[:, 2], cost=matches[:, 3])
-    for word in packed.tolist():
-        words += [(word & 0xFFFF, False, False), ((word >> 16) & 0xFFFF, False, False), (word >> 32, False, False)]
-    trailer = int(TRAILER.pack(marker=MARKER, count=len(listed), overflow=int(overflow),
-                               candidates=min(len(li), 0xFFFF)))
-    words += [(trailer & 0xFFFF, False, False), ((trailer >> 16) & 0xFFFF, False, False), (trailer >> 32, True, True)]
-    return dict(matches=matches.reshape(-1, 4).astype(np.int64), left_index=listed, right_index=j, dy=dy,
-                count=len(listed), total=len(found), overflow=bool(overflow), candidates=int(len(li)), limit=limit,
-                words=words, best=best, second=second, choice=choice, status=status,
-                pairs=dict(left=li, right=ri, cost=c))
+    return match_engine(fl, fr, descriptors(left, fl, cost, window), descriptors(right, fr, cost, window), width=w,
+                        cost=cost, window=window, limit=limit, d_min=int(d_min), d_max=int(d_max), rows=int(rows),
+                        uniqueness=int(uniqueness), lr_check=bool(lr_check), max_matches=int(max_matches))
