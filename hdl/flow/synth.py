@@ -81,7 +81,9 @@ CLOCK_GOALS = {
                           "sram_controller", "sram_arbiter", "line_cache", "stream_rectifier", "sdram_controller",
                           "sdram_bridge", "sdram_subsystem",
                           # dense disparity (issue 28) works on the rectified stream in the memory clock
-                          "census", "sgm", "median3", "dense_stereo")},
+                          "census", "sgm", "median3", "dense_stereo",
+                          # the hardware matcher (issue 29) beside them, on the same rectified stream's clock
+                          "match_engine")},
 }
 #: The thesis's own fmax figures (MHz) where it gives one: ISE's estimate for the mono Harris, "no
 #: matter which kind of non-maximum suppression" (6.2.5).

@@ -80,7 +80,10 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
     positions, the right corners' records of 40 bits), the result table (``corners`` x about 60 bits) and
     the flags, in block RAM; the event queue in LUT-RAM; the cost datapath: ``window`` 8-bit absolute
     differences and their sum (SAD) or ``window**2 - 1`` XOR gates and their count (census); two constant
-    multiplications by up to 199 for the uniqueness test.
+    multiplications by up to 199 for the uniqueness test. Measured (make synth's flow, the catalogue's
+    configuration: SAD 9 x 9, 352 x 288, 64 slots, 1023 corners): Yosys xc3se 1195 LUT + 15 LUT-RAM, 1192 FF,
+    17 RAMB16, 2 MULT18X18; ECP5 (LFE5U-25F) 1973 LUT4, 1009 FF, 15 DP16KD, 2 MULT18X18D, 114.3 / 125.1 / 134.5
+    MHz (min / median / max of nextpnr seeds 1-4; goal 100 MHz, the memory clock).
     """
     check_clock(clk)
     check_reset(rst)
@@ -122,17 +125,20 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
 
     # ---------------------------------------------------------------------------------------------------
     # Stores: descriptor words (slot, word), positions (y, x), right records (key, left number), valid flags.
-    ldesc_norw = [Signal(intbv(0)[wb:]) for _ in range(slots * nwp)]
-    rdesc_norw = [Signal(intbv(0)[wb:]) for _ in range(slots * nwp)]
-    lpos = [Signal(intbv(0)[24:]) for _ in range(slots)]  # y << 12 | x
-    rpos = [Signal(intbv(0)[24:]) for _ in range(slots)]
-    rrec = [Signal(intbv(0)[key_bits + lb:]) for _ in range(slots)]
+    ldesc_oreg_norw = [Signal(intbv(0)[wb:]) for _ in range(slots * nwp)]
+    rdesc_oreg_norw = [Signal(intbv(0)[wb:]) for _ in range(slots * nwp)]
+    # (memory names: _norw, no read of an address in the clock it is written, so Yosys needs no collision
+    # logic; _oreg, make synth moves the register after the read into the block RAM's output register, whatever
+    # the logic after it: hdl/flow/bram_regs.py)
+    lpos_norw = [Signal(intbv(0)[24:]) for _ in range(slots)]  # y << 12 | x
+    rpos_oreg_norw = [Signal(intbv(0)[24:]) for _ in range(slots)]
+    rrec_norw = [Signal(intbv(0)[key_bits + lb:]) for _ in range(slots)]
     rvalid = Signal(intbv(0)[slots:])
     # the result table, from bit 0: x (12), y (12), dy + 8 (4), d (8), cost (12: only accepted costs are
     # listed), the chosen right slot (sb), ok (1)
     rw_bits = 49 + sb
-    res = [Signal(intbv(0)[rw_bits:]) for _ in range(nres)]
-    lrok = [Signal(bool(0)) for _ in range(nres)]
+    res_oreg_norw = [Signal(intbv(0)[rw_bits:]) for _ in range(nres)]
+    lrok_oreg_norw = [Signal(bool(0)) for _ in range(nres)]
 
     # sink side
     lw = Signal(intbv(0)[sb + 1:])  # write pointers (next free slot), one bit more than a slot index
@@ -192,14 +198,19 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
 
     @always_seq(clk.posedge, reset=rst)
     def sink_side():
+        # pointers wrap by dropping the carry (a slice of a wider variable: MyHDL writes `%` of a pointer as a
+        # signed modulo, which GHDL's netlist writer cannot write)
+        nxt = intbv(0)[sb + 2:]
         if sink.valid and not sink.row_end:
             if sink.last:
                 wk.next = 0
                 if accept:
                     if sink.cam:
-                        rw.next = (rw + 1) % (2 * slots)
+                        nxt[:] = rw + 1
+                        rw.next = nxt[sb + 1:]
                     else:
-                        lw.next = (lw + 1) % (2 * slots)
+                        nxt[:] = lw + 1
+                        lw.next = nxt[sb + 1:]
             else:
                 wk.next = (wk + 1) % nwp
             if wk == 0:
@@ -211,7 +222,8 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
     # Matching side: read addresses and the pipeline's tags come from the state machine's registers.
     # (states named ST_*: VHDL is case-insensitive, and an enumeration literal may not share a signal's name)
     State = enum("ST_EVENT", "ST_ROW", "ST_NEXT_LEFT", "ST_LEFT_READ", "ST_LEFT_SETUP", "ST_SCAN", "ST_DRAIN",
-                 "ST_VERDICT1", "ST_VERDICT2", "ST_EVICT", "ST_EVICT_READ", "ST_EVICT_RES", "ST_EVICT_FLAG", "ST_EMIT",
+                 "ST_VERDICT1", "ST_VERDICT2", "ST_EVICT", "ST_EVICT_READ", "ST_EVICT_RES", "ST_EVICT_WAIT",
+                 "ST_EVICT_FLAG", "ST_EMIT",
                  "ST_EMIT_READ", "ST_EMIT_TEST", "ST_WORDS", "ST_FRAME_END")
     state = Signal(State.ST_EVENT)
     rsn = [Signal(intbv(0)[sb + 1:]) for _ in range(nring_r)]  # rsn[k]: right pointer after row (current - k)
@@ -235,7 +247,7 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
     lpa = Signal(intbv(0)[sb:])
     rsa = Signal(intbv(0)[sb:])
     ql, qr = Signal(intbv(0)[wb:]), Signal(intbv(0)[wb:])
-    qlp, qrp = Signal(intbv(0)[24:]), Signal(intbv(0)[24:])
+    qlp, qrp, qrp2 = Signal(intbv(0)[24:]), Signal(intbv(0)[24:]), Signal(intbv(0)[24:])
     qrec = Signal(intbv(0)[key_bits + lb:])
     qval = Signal(bool(0))
     rec_we = Signal(bool(0))
@@ -246,9 +258,9 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
     res_a = Signal(intbv(0)[lb:])
     res_we = Signal(bool(0))
     res_wd = Signal(intbv(0)[rw_bits:])
-    qres = Signal(intbv(0)[rw_bits:])
+    qres, qres_r = Signal(intbv(0)[rw_bits:]), Signal(intbv(0)[rw_bits:])
     ok_a = Signal(intbv(0)[lb:])
-    ok_we, ok_wd, qok = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
+    ok_we, ok_wd, qok, qok_r = Signal(bool(0)), Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
 
     @always_comb
     def read_addresses():
@@ -260,29 +272,29 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
     @always(clk.posedge)
     def left_store():
         if dwe_l:
-            ldesc_norw[dwa].next = sink.data
-        ql.next = ldesc_norw[la]
+            ldesc_oreg_norw[dwa].next = sink.data
+        ql.next = ldesc_oreg_norw[la]
 
     @always(clk.posedge)
     def right_store():
         if dwe_r:
-            rdesc_norw[dwa].next = sink.data
-        qr.next = rdesc_norw[ra]
+            rdesc_oreg_norw[dwa].next = sink.data
+        qr.next = rdesc_oreg_norw[ra]
 
     @always(clk.posedge)
     def positions():
         if dwe_l and wk == 0:
-            lpos[pwa].next = pos_in
+            lpos_norw[pwa].next = pos_in
         if dwe_r and wk == 0:
-            rpos[pwa].next = pos_in
-        qlp.next = lpos[lpa]
-        qrp.next = rpos[rsa]
+            rpos_oreg_norw[pwa].next = pos_in
+        qlp.next = lpos_norw[lpa]
+        qrp.next = rpos_oreg_norw[rsa]
 
     @always(clk.posedge)
     def records():
         if rec_we:
-            rrec[rec_wa].next = rec_wd
-        qrec.next = rrec[rsa]
+            rrec_norw[rec_wa].next = rec_wd
+        qrec.next = rrec_norw[rsa]
 
     @always_seq(clk.posedge, reset=rst)
     def valid_flags():
@@ -298,14 +310,16 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
     @always(clk.posedge)
     def results():
         if res_we:
-            res[res_a].next = res_wd
-        qres.next = res[res_a]
+            res_oreg_norw[res_a].next = res_wd
+        qres.next = res_oreg_norw[res_a]
+        qres_r.next = qres  # read a clock later: the block RAM's clock-to-output alone is most of a clock
 
     @always(clk.posedge)
     def flags():
         if ok_we:
-            lrok[ok_a].next = ok_wd
-        qok.next = lrok[ok_a]
+            lrok_oreg_norw[ok_a].next = ok_wd
+        qok.next = lrok_oreg_norw[ok_a]
+        qok_r.next = qok
 
 
     # ---------------------------------------------------------------------------------------------------
@@ -351,35 +365,48 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
         t_first[1].next = kcur == 0
         t_last[1].next = kcur == nw - 1
         t_slot[1].next = scur[sb:]
-        # stage 2: the words registered; the right corner's record, flag, candidate test, d and dy
+        # stage 2: the words, the right corner's record, flag and position registered
         ql2.next = ql
         qr2.next = qr
         t_rec[2].next = qrec
         t_val[2].next = qval
+        qrp2.next = qrp
+        # stage 3: the candidate test, d and dy, from the registered position
         xr = intbv(0)[13:]
         yr = intbv(0)[13:]
-        xr[:] = qrp[12:]
-        yr[:] = qrp[24:12]
+        xr[:] = qrp2[12:]
+        yr[:] = qrp2[24:12]
         # d_min <= xl - xr <= d_max, without a negative number (the rows are right by the range read)
-        t_cand[2].next = xl >= xr + d_min and xl <= xr + d_max
-        t_d[2].next = (xl - xr) % 256
-        t_dyc[2].next = (yr + 8 - yl) % 16
+        t_cand[3].next = xl >= xr + d_min and xl <= xr + d_max
+        # (the differences through 13-bit variables, sliced: no modulo, and in range while the pipeline reads
+        # slots that are not candidates)
+        dv = intbv(0)[13:]
+        if xl >= xr:
+            dv[:] = xl - xr
+        t_d[3].next = dv[8:]
+        yv = intbv(0)[13:]
+        if yr + 8 >= yl:
+            yv[:] = yr + 8 - yl
+        t_dyc[3].next = yv[4:]
+        av = intbv(0)[13:]
         if yr >= yl:
-            t_ady[2].next = (yr - yl) % 8
+            av[:] = yr - yl
         else:
-            t_ady[2].next = (yl - yr) % 8
+            av[:] = yl - yr
+        t_ady[3].next = av[3:]
         for i in range(2, 7):
             t_go[i].next = t_go[i - 1]
             t_first[i].next = t_first[i - 1]
             t_last[i].next = t_last[i - 1]
             t_slot[i].next = t_slot[i - 1]
         for i in range(3, 7):
+            t_rec[i].next = t_rec[i - 1]
+            t_val[i].next = t_val[i - 1]
+        for i in range(4, 7):
             t_cand[i].next = t_cand[i - 1]
             t_d[i].next = t_d[i - 1]
             t_dyc[i].next = t_dyc[i - 1]
             t_ady[i].next = t_ady[i - 1]
-            t_rec[i].next = t_rec[i - 1]
-            t_val[i].next = t_val[i - 1]
 
     datapath = []
     for j in range(nel):
@@ -432,7 +459,7 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
     @always_comb
     def decide():
         verdict.next = thr_ok and (not have_second or p_best <= p_second)
-        dy_top.next = not qres[27]
+        dy_top.next = not qres_r[27]
 
     @always_comb
     def event_head():
@@ -448,6 +475,9 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
 
     @always_seq(clk.posedge, reset=rst)
     def machine():
+        ln = intbv(0)[sb + 2:]  # the next left / right slot pointer, before its carry is dropped
+        sn = intbv(0)[sb + 2:]
+        en = intbv(0)[lb + 2:]  # the next left number to list
         rec_we.next = False
         val_set.next = False
         val_clear.next = False
@@ -509,7 +539,8 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
             kcur.next = 0
             if lid >= corners:
                 drop_any.next = True
-                lcur.next = (lcur + 1) % (2 * slots)
+                ln[:] = lcur + 1
+                lcur.next = ln[sb + 1:]
                 state.next = State.ST_NEXT_LEFT
             else:
                 state.next = State.ST_SCAN
@@ -519,7 +550,8 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
                 state.next = State.ST_DRAIN
             elif kcur == nw - 1:
                 kcur.next = 0
-                scur.next = (scur + 1) % (2 * slots)
+                sn[:] = scur + 1
+                scur.next = sn[sb + 1:]
             else:
                 kcur.next = kcur + 1
         elif state == State.ST_DRAIN:
@@ -541,7 +573,8 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
             ok_a.next = lid[lb:]
             ok_wd.next = False
             lid.next = lid + 1
-            lcur.next = (lcur + 1) % (2 * slots)
+            ln[:] = lcur + 1
+            lcur.next = ln[sb + 1:]
             state.next = State.ST_NEXT_LEFT
         elif state == State.ST_EVICT:  # right row seen - 1 - 2 rows leaves: [rsn[2 rows + 1], rsn[2 rows])
             if scur == send:
@@ -573,18 +606,22 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
                 ok_a.next = qrec[lb:]
                 state.next = State.ST_EVICT_RES
             else:
-                scur.next = (scur + 1) % (2 * slots)
+                sn[:] = scur + 1
+                scur.next = sn[sb + 1:]
                 state.next = State.ST_EVICT
-        elif state == State.ST_EVICT_RES:  # the result of its best left corner is read
+        elif state == State.ST_EVICT_RES:  # the result of its best left corner is read ...
+            state.next = State.ST_EVICT_WAIT
+        elif state == State.ST_EVICT_WAIT:  # ... and registered
             state.next = State.ST_EVICT_FLAG
         elif state == State.ST_EVICT_FLAG:
             # set, never cleared here: several right corners may have this left corner as their best
-            if qres[48 + sb:48] == scur[sb:]:
+            if qres_r[48 + sb:48] == scur[sb:]:
                 ok_we.next = True
                 ok_wd.next = True
             val_clear.next = True
             val_clear_a.next = scur[sb:]
-            scur.next = (scur + 1) % (2 * slots)
+            sn[:] = scur + 1
+            scur.next = sn[sb + 1:]
             state.next = State.ST_EVICT
         elif state == State.ST_EMIT:  # the result and the flag of left corner emit_i are read
             if emit_i == lid:
@@ -598,17 +635,18 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
             state.next = State.ST_EMIT_TEST
         elif state == State.ST_EMIT_TEST:
             emit_i.next = emit_i + 1
-            res_a.next = (emit_i + 1) % nres
-            ok_a.next = (emit_i + 1) % nres
-            if qres[48 + sb] and (qok or not lr_check):
+            en[:] = emit_i + 1
+            res_a.next = en[lb:]
+            ok_a.next = en[lb:]
+            if qres_r[48 + sb] and (qok_r or not lr_check):
                 if count == max_matches:
                     overflow.next = True
                     state.next = State.ST_EMIT
                 else:
                     count.next = count + 1
                     # MATCH: x, dy (two's complement: dy + 8 with its top bit inverted), y, d, cost
-                    out_w.next = concat(qres[48:36], qres[36:28], qres[24:12], dy_top, qres[27:24],
-                                        qres[12:])
+                    out_w.next = concat(qres_r[48:36], qres_r[36:28], qres_r[24:12], dy_top, qres_r[27:24],
+                                        qres_r[12:])
                     out_k.next = 0
                     trailer.next = False
                     state.next = State.ST_WORDS

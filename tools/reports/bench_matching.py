@@ -576,7 +576,8 @@ def main(argv=None) -> int:
         adaptive="\n".join(l_adapt), elapsed=f"{elapsed:.0f}",
         tsukuba_dense=(f"{r_dense['Tsukuba']['t_sad'] * 1e3:.0f} ms" if "Tsukuba" in r_dense else "n/a"),
         tsukuba_factor=(f"{5.1 / r_dense['Tsukuba']['t_sad']:.0f}" if "Tsukuba" in r_dense else "n/a"),
-        findings=findings(sets, r_tmax, r_win, r_split, r_dense, r_adapt, r_robust))
+        findings=findings(sets, r_tmax, r_win, r_split, r_dense, r_adapt, r_robust),
+        hardware=hardware_part(args.out))
     if write:
         atomic_write_text(args.out, text)
         print(f"-> {args.out} ({elapsed:.0f} s)")
@@ -628,6 +629,23 @@ def findings(sets, r_tmax, r_win, r_split, r_dense, r_adapt, r_robust) -> str:
                    f"{rows['secant (log, per-block slope)'].mean():.2f} (secant) vs {rows[best_i].mean():.2f} "
                    f"(best I-controller, {best_i}) and {rows['I, gain 0.5'].mean():.2f} (I, gain 0.5).")
     return "\n".join(out)
+
+
+#: The page's hardware part (the matcher on the FPGA, issue 29): its own measurement scripts fill it, and this
+#: script carries it over from the page it rewrites.
+HARDWARE_BEGIN, HARDWARE_END = "<!-- hardware: begin -->", "<!-- hardware: end -->"
+
+
+def hardware_part(page) -> str:
+    """The hardware part of the page being rewritten (markers included), or the empty part with its markers."""
+    try:
+        old = Path(page).read_text(encoding="utf-8") if page else ""
+    except OSError:
+        old = ""
+    a, b = old.find(HARDWARE_BEGIN), old.find(HARDWARE_END)
+    if a >= 0 and b > a:
+        return old[a:b + len(HARDWARE_END)]
+    return f"{HARDWARE_BEGIN}\n{HARDWARE_END}"
 
 
 TEMPLATE = """# Feature matching in software, evaluated on Middlebury (thesis 7.2-7.3)
@@ -811,6 +829,8 @@ of the four cases; in single segments a gain-tuned I-controller is sometimes a l
 operating point it suits. What no controller can fix is the threshold's resolution at low contrast:
 the code's step is 2^21 in cornerness units, and at contrast x0.6 most codes for 31 corners per block are
 0..10 (median 0), so a block can only jump between counts.
+
+{hardware}
 
 ## Findings
 
