@@ -653,7 +653,7 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
             else:
                 state.next = State.ST_EMIT
         elif state == State.ST_WORDS:
-            if source.ready and source.valid:
+            if source.ready and out_valid:
                 if out_k == 2:
                     if trailer:
                         state.next = State.ST_FRAME_END
@@ -674,13 +674,19 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
                 lsn[k].next = lsn[0]
             state.next = State.ST_EVENT
 
+    out_valid = Signal(bool(0))  # source.valid, read here (VHDL-93 reads no output port)
+
+    @always_comb
+    def valid_out():
+        source.valid.next = out_valid
+
     @always_seq(clk.posedge, reset=rst)
     def words_out():
         # the list's words: a register per field of the queue port, loaded as the state machine moves on
-        if state == State.ST_WORDS and not (source.valid and source.ready and out_k == 2):
-            source.valid.next = True
+        if state == State.ST_WORDS and not (out_valid and source.ready and out_k == 2):
+            out_valid.next = True
             k = intbv(0, min=0, max=4)
-            if source.valid and source.ready:
+            if out_valid and source.ready:
                 k[:] = out_k + 1
             else:
                 k[:] = out_k
@@ -693,11 +699,11 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
             source.eol.next = trailer and k == 2
             source.eof.next = trailer and k == 2
         else:
-            source.valid.next = False
+            out_valid.next = False
 
     return (sink_decode, position, sink_accept, sink_write, sink_side, events_fifo, read_addresses, left_store,
             right_store, positions, records, valid_flags, results, flags, issuing, pipeline, datapath,
-            accumulate, keys, decide, event_head, sticky, machine, words_out)
+            accumulate, keys, decide, event_head, sticky, machine, valid_out, words_out)
 
 
 @block
