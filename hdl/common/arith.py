@@ -1,6 +1,6 @@
 """Constant-coefficient arithmetic by shifts and adds, with signals sized from exact value ranges."""
 
-from myhdl import Signal, always_comb, block, intbv
+from myhdl import Signal, always, always_comb, block, intbv
 
 from eyestereo.hdl.common.registers import assign, delay
 
@@ -142,6 +142,40 @@ def adder(a, b, s):
         s.next = a + b
 
     return add
+
+
+@block
+def chunk_count(clk, a, b, n, *, lo: int, hi: int):
+    """Registered count of the bits lo .. hi-1 where a and b differ (a Hamming distance in chunks: 3-bit chunks
+    make each count bit a function of 6 inputs, two LUT levels)."""
+
+    @always(clk.posedge)
+    def count():
+        c = intbv(0, min=0, max=hi - lo + 1)
+        for i in range(lo, hi):
+            if a[i] != b[i]:
+                c[:] = c + 1
+        n.next = c
+
+    return count
+
+
+@block
+def sum_tree(clk, terms, total):
+    """Registered sum of ``terms``: a tree of :func:`adder`, each in the total's width, then one register."""
+    insts = []
+    level = list(terms)
+    while len(level) > 1:
+        nxt = []
+        for i in range(0, len(level) - 1, 2):
+            s = Signal(intbv(0, min=0, max=total.max))
+            insts.append(adder(level[i], level[i + 1], s))
+            nxt.append(s)
+        if len(level) % 2:
+            nxt.append(level[-1])
+        level = nxt
+    insts.append(delay(clk, level[0], total, clocks=1))
+    return insts
 
 
 def signed_copy(sig):

@@ -4,6 +4,7 @@ from myhdl import ConcatSignal, Signal, always, always_comb, block, concat, intb
 
 from eyestereo.hdl.common.checks import (block_error, check_choice, check_clock, check_distinct,
                                          check_frame, check_int, check_reset, check_signal, check_stream)
+from eyestereo.hdl.common.arith import chunk_count, sum_tree
 from eyestereo.hdl.common.registers import delay, like_signal
 from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 from eyestereo.tools.models.census import WINDOWS, census_bits
@@ -654,48 +655,6 @@ def cost_lane(clk, we, wa, wd, xm, cl, cand4, cost, *, k: int, pu: int, rr: int,
             cost.next = total
 
     return insts + [cand_bit, saturate]
-
-
-@block
-def chunk_count(clk, a, b, n, *, lo: int, hi: int):
-    """Registered count of the bits lo .. hi-1 where a and b differ (stage 3)."""
-
-    @always(clk.posedge)
-    def count():
-        c = intbv(0, min=0, max=hi - lo + 1)
-        for i in range(lo, hi):
-            if a[i] != b[i]:
-                c[:] = c + 1
-        n.next = c
-
-    return count
-
-
-@block
-def sum_tree(clk, terms, total):
-    """Registered sum of ``terms`` (stage 4): a tree of adders, each in the total's width."""
-    insts = []
-    level = list(terms)
-    while len(level) > 1:
-        nxt = []
-        for i in range(0, len(level) - 1, 2):
-            s = Signal(intbv(0, min=0, max=total.max))
-            insts.append(add2(level[i], level[i + 1], s))
-            nxt.append(s)
-        if len(level) % 2:
-            nxt.append(level[-1])
-        level = nxt
-    insts.append(delay(clk, level[0], total, clocks=1))
-    return insts
-
-
-@block
-def add2(a, b, s):
-    @always_comb
-    def logic():
-        s.next = a + b
-
-    return logic
 
 
 @block

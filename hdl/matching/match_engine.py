@@ -5,7 +5,7 @@ from myhdl import Signal, always, always_comb, always_seq, block, concat, enum, 
 from eyestereo.hdl.common.checks import (block_error, check_choice, check_clock, check_distinct,
                                          check_int, check_reset, check_signal)
 from eyestereo.hdl.common.fifo import sync_fifo
-from eyestereo.hdl.common.registers import dreg
+from eyestereo.hdl.common.arith import chunk_count, sum_tree
 from eyestereo.hdl.interfaces.descriptor import check_descriptor
 from eyestereo.hdl.interfaces.queue import check_queue
 from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
@@ -413,10 +413,10 @@ def match_engine(clk, rst, sink, source, limit, uniqueness, lr_check, dropped, *
         if sad:
             datapath.append(abs_diff(clk, ql2, qr2, els[j], lo=8 * j))
         else:
-            datapath.append(diff_count(clk, ql2, qr2, els[j], lo=3 * j, hi=min(wb, 3 * j + 3)))
+            datapath.append(chunk_count(clk, ql2, qr2, els[j], lo=3 * j, hi=min(wb, 3 * j + 3)))
     for g in range(ngroups):
-        datapath.append(group_sum(clk, els[g * group:(g + 1) * group], gsum[g]))
-    datapath.append(group_sum(clk, gsum, wsum))
+        datapath.append(sum_tree(clk, els[g * group:(g + 1) * group], gsum[g]))
+    datapath.append(sum_tree(clk, gsum, wsum))
 
     @always(clk.posedge)
     def accumulate():
@@ -720,49 +720,5 @@ def abs_diff(clk, a, b, out, *, lo: int):
             out.next = x - y
         else:
             out.next = y - x
-
-    return logic
-
-
-@block
-def diff_count(clk, a, b, n, *, lo: int, hi: int):
-    """Registered count of the bits lo .. hi-1 where a and b differ (stage 3, census)."""
-
-    @always(clk.posedge)
-    def count():
-        c = intbv(0, min=0, max=hi - lo + 1)
-        for i in range(lo, hi):
-            if a[i] != b[i]:
-                c[:] = c + 1
-        n.next = c
-
-    return count
-
-
-@block
-def group_sum(clk, terms, total):
-    """Registered sum of a few terms (stages 4 and 5): a tree of two-input adders, then the register."""
-    insts = []
-    level = list(terms)
-    while len(level) > 1:
-        nxt = []
-        for i in range(0, len(level) - 1, 2):
-            s = Signal(intbv(0, min=0, max=total.max))
-            insts.append(add2(level[i], level[i + 1], s))
-            nxt.append(s)
-        if len(level) % 2:
-            nxt.append(level[-1])
-        level = nxt
-    insts.append(dreg(clk, level[0], total))
-    return insts
-
-
-@block
-def add2(a, b, s):
-    """s = a + b."""
-
-    @always_comb
-    def logic():
-        s.next = a + b
 
     return logic
