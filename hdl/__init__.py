@@ -32,6 +32,7 @@ _EXPORTS = {
     "sgm": "dense.sgm",
     "median3": "dense.median3",
     "dense_stereo": "dense.dense_stereo",
+    "corner_descriptors": "matching.corner_descriptors",
     "match_engine": "matching.match_engine",
     "harris_mono": "harris.harris_mono",
     "harris_stereo": "harris.harris_stereo",

@@ -34,6 +34,7 @@ from eyestereo.hdl.dense.median3 import median3
 from eyestereo.hdl.dense.sgm import sgm
 from eyestereo.hdl.dense.dense_stereo import dense_stereo
 from eyestereo.hdl.interfaces.descriptor import DescriptorPort
+from eyestereo.hdl.matching.corner_descriptors import corner_descriptors
 from eyestereo.hdl.matching.match_engine import limit_bits, match_engine
 from eyestereo.tools.models.match_engine import word_bits as match_word_bits
 from eyestereo.hdl.harris.cornerness import cornerness
@@ -313,6 +314,14 @@ def _build_match_engine(p):
                        lr_check=Signal(bool(0)), dropped=Signal(bool(0)))
 
 
+def _build_corner_descriptors(p):
+    # a stereo sink of grey pixels, a stereo sink of flags, the descriptor port of the cost's words, two counts
+    return fresh_ports(corner_descriptors, sink=ImageStream(8, stereo=True), flags=ImageStream(1, stereo=True),
+                       source=DescriptorPort(match_word_bits(p["cost"], p["window"]), width=p["width"],
+                                             height=p["height"]),
+                       late=Signal(intbv(0)[16:]), lost=Signal(intbv(0)[16:]))
+
+
 def _build_coordinate_warper(p):
     cal = calibration(p)
     return fresh_ports(coordinate_warper, start=_bit(p), enable=_bit(p), busy=_bit(p), done=_bit(p),
@@ -395,6 +404,9 @@ BLOCKS: dict[str, BlockSpec] = {b.name: b for b in (
           "left-right check, sub-pixel; 16-bit codes", sgm, build=_build_sgm),
     block("dense_stereo", "census, sgm and the 3x3 median: a rectified stereo stream in, disparity codes out",
           dense_stereo, build=_build_dense_stereo),
+    block("corner_descriptors", "rectified stereo pixels and corner flags -> every corner's window (SAD columns or "
+          "a census word) on the descriptor port, row by row; flags joined by position", corner_descriptors,
+          build=_build_corner_descriptors),
     block("match_engine", "corner descriptors of both cameras -> the frame's match list: candidates in a disparity "
           "range and +-R rows, SAD or census costs, best and second best, threshold, uniqueness, left-right check",
           match_engine, build=_build_match_engine),

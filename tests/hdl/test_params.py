@@ -264,6 +264,8 @@ def _small(spec):
     small = {k: v for k, v in SMALL_FRAME.items() if k in spec.defaults}
     if "disparities" in spec.defaults and "width" in spec.defaults:
         small.update(width=24, disparities=16)  # the dense blocks' frame must be wider than D
+    if "lead" in spec.defaults and "border" in spec.defaults:
+        small.update(height=16)  # corner_descriptors: a corner 4 (the border) from each edge needs 9 rows
     return small
 
 

@@ -89,11 +89,11 @@ def test_max_matches_cuts_the_list_like_the_rules():
     assert (marker, count) == (E.MARKER, 5 | 1 << 15)
 
 
-def test_sad_words_are_the_window_rows_left_pixel_lowest():
-    win = np.arange(25).reshape(1, 25) * 10  # row k: 50k, 50k + 10, ..., 50k + 40
+def test_sad_words_are_the_window_columns_top_pixel_lowest():
+    win = np.arange(25).reshape(1, 25) * 10  # row i: 50i, 50i + 10, ..., 50i + 40; column k: 10k, 10k + 50, ...
     words = E.pack_descriptors(win, "sad", 5)
-    assert words[0][0] == 0 | 10 << 8 | 20 << 16 | 30 << 24 | 40 << 32
-    assert words[0][4] == 200 | 210 << 8 | 220 << 16 | 230 << 24 | 240 << 32
+    assert words[0][0] == 0 | 50 << 8 | 100 << 16 | 150 << 24 | 200 << 32
+    assert words[0][4] == 40 | 90 << 8 | 140 << 16 | 190 << 24 | 240 << 32
     assert len(words[0]) == E.descriptor_words("sad", 5) and E.word_bits("sad", 5) == 40
 
 

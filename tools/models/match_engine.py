@@ -5,7 +5,9 @@ whole): it takes, per camera, the corners of a frame in raster order with one **
 writes the frame's match list. The descriptor is what the cost needs of the window around the corner:
 
 * ``"sad"``: the ``window`` x ``window`` grey levels, ``window`` words of ``8 * window`` bits, word k the
-  window's row k, pixel j of the row in bits ``8 j + 7 .. 8 j`` (the window's left column lowest);
+  window's column k (left to right), the pixel of row i in bits ``8 i + 7 .. 8 i`` (the top row lowest): a
+  column per word because the front half reads a window from its line buffers a column per clock (all rows
+  at one address); the cost is a sum over the pixels, so the layout only has to be the same for both cameras;
 * ``"census"``: one word of ``window**2 - 1`` bits, the census bits in the window's raster order, the
   top-left neighbour the most significant (the census block's word).
 
@@ -60,12 +62,12 @@ _CHUNK = 1 << 21  # pixel differences per chunk of pairs (memory bound, a few MB
 
 
 def descriptor_words(cost: str, window: int) -> int:
-    """Words per descriptor: ``window`` for SAD (a row each), 1 for census."""
+    """Words per descriptor: ``window`` for SAD (a column each), 1 for census."""
     return window if cost == "sad" else 1
 
 
 def word_bits(cost: str, window: int) -> int:
-    """Bits of a descriptor word: ``8 * window`` (SAD: a row of grey levels) or ``window**2 - 1`` (census)."""
+    """Bits of a descriptor word: ``8 * window`` (SAD: a column of grey levels) or ``window**2 - 1`` (census)."""
     return 8 * window if cost == "sad" else window * window - 1
 
 
@@ -80,9 +82,9 @@ def pack_descriptors(desc: np.ndarray, cost: str, window: int) -> list[list[int]
     :func:`descriptor_words` ints."""
     d = np.asarray(desc)
     if cost == "sad":
-        rows = d.reshape(len(d), window, window).astype(np.int64)
-        weights = [1 << (8 * j) for j in range(window)]
-        return [[int(sum(int(p) * w for p, w in zip(row, weights))) for row in corner] for corner in rows]
+        cols = d.reshape(len(d), window, window).transpose(0, 2, 1).astype(np.int64)  # [corner, column, row]
+        weights = [1 << (8 * i) for i in range(window)]
+        return [[int(sum(int(p) * w for p, w in zip(col, weights))) for col in corner] for corner in cols]
     nb = window * window - 1
     # Python ints: a word of 9 x 9 or 11 x 11 bits is wider than numpy's int64
     return [[sum(1 << (nb - 1 - int(i)) for i in np.flatnonzero(bits))] for bits in d.astype(bool)]
