@@ -161,6 +161,8 @@ bench: setup
 	$(PY) -m eyestereo.tools.reports.bench_matching --middlebury $(SHARED)/middlebury --out docs/matching.md \
 	  --img docs/img
 	$(PY) -m eyestereo.sim.measure.bench_matcher --sims verilator,ghdl,icarus --out docs/matching.md
+	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.sim.measure.bench_feature_matcher \
+	  --sims verilator,ghdl,icarus --out docs/matching.md
 	$(PY) -m eyestereo.sim.measure.bench_camera --out docs/camera.md
 	$(PY) -m eyestereo.sim.measure.bench_sram --out docs/sram.md
 	EYESTEREO_SHARED_DATA=$(SHARED) $(PY) -m eyestereo.tools.reports.rectifier_precision

@@ -34,6 +34,8 @@ _EXPORTS = {
     "dense_stereo": "dense.dense_stereo",
     "corner_descriptors": "matching.corner_descriptors",
     "match_engine": "matching.match_engine",
+    "feature_matcher": "matching.feature_matcher",
+    "list_append": "system.list_append",
     "harris_mono": "harris.harris_mono",
     "harris_stereo": "harris.harris_stereo",
     "feature_list": "harris.feature_list",

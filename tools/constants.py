@@ -43,3 +43,8 @@ __all__ = ["FRAME_WIDTH", "FRAME_HEIGHT", "FRAME_MIN", "FRAME_MAX", "THRESHOLD_B
 #: (``eyestereo.tools.models.dense_stereo.DEFAULTS``) and the DENSE register's reset values.
 DENSE_DEFAULTS = dict(window=5, disparities=64, paths=4, p1=10, p2=30, uniqueness=10, lr_check=True, subpixel=True,
                       median=True)
+
+#: The first word of a match list's trailer (the hardware matcher's, issue 29; ``eyestereo.tools.models.match_engine``
+#: declares the list's words): a match's first word never equals it (dy = -8, which no match has). Here, not in the
+#: model, so that the host driver (which imports no model) finds a list's end by the same constant.
+MATCH_MARKER = 0x8000

@@ -24,6 +24,7 @@ Plain Python (no MyHDL, no cocotb).
 
 from __future__ import annotations
 
+from eyestereo.tools.constants import MATCH_MARKER
 from eyestereo.tools.regmap import ARB_WORDS, OKAY, REGMAP, RegisterMap, check_bits
 
 __all__ = ["HostDriver", "BusError", "ModelBus"]
@@ -244,6 +245,20 @@ class HostDriver:
         codes = await self.read_sram_words(amap.disparity(st["disp_buf"]), amap.width * amap.height)
         await self.pulse("disp_release")
         return codes
+
+    async def read_match_list(self, base: int, *, limit: int = 3 * 32768) -> list[int]:
+        """The words of a match list from SRAM word ``base`` (the front end's matcher option: the held feature
+        buffer's :meth:`~eyestereo.tools.models.sram_arbiter.AddressMap.features` +
+        :func:`~eyestereo.tools.models.sram_arbiter.match_offset`), its trailer included: three words per match,
+        up to the trailer's marker (0x8000 at a match's first word), then the trailer's count and candidates.
+        BusError when no trailer comes within ``limit`` words."""
+        words: list[int] = []
+        while len(words) < limit:
+            trip = await self.read_sram_words(base + len(words), 3)
+            words += trip
+            if trip[0] == MATCH_MARKER:
+                return words
+        raise BusError(f"no match list trailer within {limit} words from SRAM word {base}")
 
     async def write_sram_words(self, word: int, values) -> None:
         """SRAM words ``values`` from word address ``word`` on. The range must lie in the SRAM window and

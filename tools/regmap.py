@@ -295,6 +295,7 @@ def _f(name, lsb, width, doc, **kw) -> Field:
 
 _DISP = "disparity_writer (stereo_frontend's dense option)"
 _DENSE = "dense_stereo's port of the same name (stereo_frontend's dense option)"
+_MATCH = "feature_matcher (stereo_frontend's matcher option):"
 
 
 def _ctl(name, lsb, doc, width=1) -> Field:
@@ -378,6 +379,24 @@ REGISTERS: tuple[Register, ...] = (
                  "the rectifier so that it should never be set)", connect=_DENSE),
               _f("disp_lost", 17, 1, "a disparity code found the writer's FIFO full (sticky: the memory did not keep "
                  "up)", connect=_DISP))),
+    Register("MATCH", 0x03C, "rw", "the matcher option's run-time settings (feature_matcher's ports; no effect "
+             "without the option)",
+             (_f("match_limit", 0, 13, "a best cost is accepted below this (reset: 891 = 11 x 81, SAD 9 x 9 with "
+                 "t_max 11; census: ceil(h_max (window**2 - 1) / 100), 12 for 9 x 9 at 15 %)", reset=11 * 81,
+                 connect=_MATCH + " limit"),
+              _f("match_uniqueness", 16, 7, "uniqueness in percent, 0 off, at most 99 (reset: 0)", reset=0,
+                 connect=_MATCH + " uniqueness"),
+              _f("match_lr_check", 24, 1, "left-right check on (reset: 1)", reset=1, connect=_MATCH + " lr_check"))),
+    Register("MATCH_STATUS", 0x040, "status", "the matcher option's last list and faults (reads 0 without it)",
+             (_f("matches", 0, 15, "matches in the last match list written (its trailer's count)",
+                 connect="list_append count"),
+              _f("match_overflow", 15, 1, "that list was cut at max_matches", connect="list_append overflow"),
+              _f("match_dropped", 16, 1, "the match engine could not keep a corner, a row end or a left corner "
+                 "since reset (sticky; the lists are not the model's then)", connect=_MATCH + " dropped"))),
+    Register("MATCH_FAULTS", 0x044, "status", "corners the matcher skipped since reset (reads 0 without it)",
+             (_f("match_late", 0, 16, "corners whose flag came after their window had left the line buffers",
+                 connect=_MATCH + " late"),
+              _f("match_lost", 16, 16, "corners that found the pending queue full", connect=_MATCH + " lost"))),
     Register("THR_LEFT", 0x100, "array", "pre-threshold of each 4x4 block of the left image, index by*4 + bx "
              "(20-bit cornerness code; 0 after reset)",
              (_f("thr_left", 0, THRESHOLD_BITS, "threshold code",

@@ -35,6 +35,8 @@ from eyestereo.hdl.dense.sgm import sgm
 from eyestereo.hdl.dense.dense_stereo import dense_stereo
 from eyestereo.hdl.interfaces.descriptor import DescriptorPort
 from eyestereo.hdl.matching.corner_descriptors import corner_descriptors
+from eyestereo.hdl.matching.feature_matcher import feature_matcher
+from eyestereo.hdl.system.list_append import list_append
 from eyestereo.hdl.matching.match_engine import limit_bits, match_engine
 from eyestereo.tools.models.match_engine import word_bits as match_word_bits
 from eyestereo.hdl.harris.cornerness import cornerness
@@ -322,6 +324,20 @@ def _build_corner_descriptors(p):
                        late=Signal(intbv(0)[16:]), lost=Signal(intbv(0)[16:]))
 
 
+def _build_feature_matcher(p):
+    # the pixels, the flags, the 16-bit list port, the engine's settings, its flag and the two counts
+    return fresh_ports(feature_matcher, sink=ImageStream(8, stereo=True), flags=ImageStream(1, stereo=True),
+                       source=QueuePort(16), limit=Signal(intbv(0)[limit_bits():]), uniqueness=Signal(intbv(0)[7:]),
+                       lr_check=Signal(bool(0)), dropped=Signal(bool(0)), late=Signal(intbv(0)[16:]),
+                       lost=Signal(intbv(0)[16:]))
+
+
+def _build_list_append(p):
+    # the feature lists, the match lists, the joined lists, the last list's count and overflow flag
+    return fresh_ports(list_append, sink=QueuePort(16), matches=QueuePort(16), source=QueuePort(16),
+                       count=Signal(intbv(0)[15:]), overflow=Signal(bool(0)))
+
+
 def _build_coordinate_warper(p):
     cal = calibration(p)
     return fresh_ports(coordinate_warper, start=_bit(p), enable=_bit(p), busy=_bit(p), done=_bit(p),
@@ -410,6 +426,10 @@ BLOCKS: dict[str, BlockSpec] = {b.name: b for b in (
     block("match_engine", "corner descriptors of both cameras -> the frame's match list: candidates in a disparity "
           "range and +-R rows, SAD or census costs, best and second best, threshold, uniqueness, left-right check",
           match_engine, build=_build_match_engine),
+    block("feature_matcher", "corner_descriptors + match_engine: rectified stereo pixels and corner flags in, each "
+          "frame's match list (x, y, disparity, cost) out", feature_matcher, build=_build_feature_matcher),
+    block("list_append", "a frame's feature list, filler up to a fixed word, then its match list: one list buffer "
+          "for both (the front end's matcher option)", list_append, build=_build_list_append),
     block("median3", "3x3 median of 16-bit disparity codes (0xFFFF = invalid, the largest), border pixels passed "
           "through", median3, sink_width=_fixed(16), source_width=_fixed(16)),
     block("poly_unit", "the four rectification polynomials, 8-stage pipeline, 9 multipliers, 1 coordinate/clock",

@@ -244,6 +244,7 @@ def corner_descriptors(clk, rst, sink, flags, source, late, lost, *, cost: str =
     State = enum("ST_IDLE", "ST_READ")
     state = Signal(State.ST_IDLE)
     hx = Signal(intbv(0, min=0, max=width))
+    hx0 = Signal(intbv(0, min=0, max=width))  # the window's first column, hx - r (the border keeps it >= 0)
     hy = Signal(intbv(0, min=0, max=height))
     hcam = Signal(bool(0))
     # every clock, from the head and the writer's registers: the rows the writer is past the head's row, and the
@@ -327,6 +328,7 @@ def corner_descriptors(clk, rst, sink, flags, source, late, lost, *, cost: str =
                     oy.next = oy + 1
             elif q_pop and not late_inc:
                 hx.next = head_x
+                hx0.next = head_x - r
                 hy.next = head_y
                 hcam.next = head_cam
                 t[:] = ws_s - row_lag - r  # the buffer holding the window's top row
@@ -347,7 +349,7 @@ def corner_descriptors(clk, rst, sink, flags, source, late, lost, *, cost: str =
             i_x.next = hx
             i_y.next = hy
             i_s0.next = s0
-            raddr.next = hx - r + k
+            raddr.next = hx0 + k  # unsigned + unsigned: no signed operand in MyHDL's Verilog
             rcam.next = hcam
             i_centre.next = not centre_done
             if not centre_done:

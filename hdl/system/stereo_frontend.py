@@ -26,6 +26,11 @@ from eyestereo.hdl.rectify.fetch_gate import fetch_gate
 from eyestereo.hdl.dense.dense_stereo import dense_stereo
 from eyestereo.hdl.dense.sgm import PU_CHOICES
 from eyestereo.hdl.system.disparity_writer import disparity_writer
+from eyestereo.hdl.system.list_append import list_append
+from eyestereo.hdl.matching.feature_matcher import feature_matcher
+from eyestereo.hdl.harris.harris_stereo import latency as harris_latency
+from eyestereo.tools.models.match_engine import COSTS as MATCH_COSTS, WINDOWS as MATCH_WINDOWS, MAX_DISPARITY, MAX_ROWS
+from eyestereo.tools.models.sram_arbiter import list_words, match_offset
 from eyestereo.tools.models.sgm import D_RANGE, PATHS
 from eyestereo.tools.models.sram_arbiter import AddressMap
 from eyestereo.hdl.system.register_bank import RegisterPorts, register_bank
@@ -45,7 +50,8 @@ from eyestereo.tools.constants import DENSE_DEFAULTS, NMS_DEFAULT, NMS_SIZES, TH
 from eyestereo.tools.regmap import REGMAP
 from eyestereo.tools.sram import KINDS
 
-__all__ = ["stereo_frontend", "dense_option", "dense_fifo", "BLOCKS", "CAM_DEPTH", "MEMORY", "RECTIFY", "THR_BITS"]
+__all__ = ["stereo_frontend", "dense_option", "matcher_option", "dense_fifo", "BLOCKS", "CAM_DEPTH", "MEMORY",
+           "RECTIFY", "THR_BITS"]
 
 #: The rectification choices: from the frame store (the thesis's) or from an on-chip line cache.
 RECTIFY = ("fetch", "stream")
@@ -67,12 +73,13 @@ CAM_DEPTH = FIFO_DEPTH
 @block
 def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sram, *, quantizers="rig",
                     frac: int | None = unit_model.DEFAULT_FRAC, nms: int = NMS_DEFAULT, border: int | None = None,
-                    max_features: int = 1023, feature_words: int = 2048, cam_depth: int = CAM_DEPTH,
+                    max_features: int = 1023, feature_words: int | None = None, cam_depth: int = CAM_DEPTH,
                     kind: str = "nobl", read_latency: int = 2, order: str = "YUYV", rect_depth: int = DEFAULT_DEPTH,
                     single_clock: bool = False, rectify: str = "fetch", cache_lines: int | None = None,
                     memory: str = "sram", sdram_part: str = ULX3S, dense: bool = False,
                     disparities: int = DENSE_DEFAULTS["disparities"], pu: int = 4,
-                    paths: int = DENSE_DEFAULTS["paths"]):
+                    paths: int = DENSE_DEFAULTS["paths"], matcher: bool = False, match_cost: str = "sad",
+                    match_window: int = 9, match_d_max: int = 64, match_rows: int = 0, max_matches: int = 1023):
     """The complete stereo front end of the thesis's Fig. 7.2, with the processor's register bus.
 
     Data flow: each camera bus -> :func:`~eyestereo.hdl.camera.camera_interface.camera_pair` (converter and
@@ -113,7 +120,9 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
         nms: harris_stereo's. Its ``share`` is not a parameter here: the rectifier's stream comes up to a beat
             every 2 Harris clocks with no back-pressure, which only share 1 (a beat per clock) takes.
         border: feature_list's border (default harris_stereo's r = 3 + nms // 2).
-        max_features, feature_words: features per list and the SRAM words of each list buffer.
+        max_features, feature_words: features per list and the SRAM words of each list buffer (default
+            :func:`~eyestereo.tools.models.sram_arbiter.list_words`: 2048 for 1023 features; with the matcher
+            5123, the match list's room too).
         cam_depth: each camera FIFO's entries (default :data:`CAM_DEPTH` = 32, LUT-RAM; 1024 = one RAMB16).
         kind, read_latency: the SRAM part (sram_controller).
         order: the cameras' byte order.
@@ -155,6 +164,17 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
             3,872, PU 4 6,336: too slow).
         disparities, pu, paths: the dense core's D (16..128, below ``width``), disparities per clock and
             aggregation paths (2 or 4), as :func:`~eyestereo.hdl.dense.sgm.sgm`'s.
+        matcher: False (default) or True: the frame's Harris corners matched on the FPGA (issue 29):
+            :func:`~eyestereo.hdl.matching.feature_matcher.feature_matcher` in the memory clock on the rectified
+            stream and the flags the feature list takes (its border, Harris's lead of ``3 + nms // 2`` rows);
+            its match list goes into the frame's feature-list buffer after the features, from word
+            :func:`~eyestereo.tools.models.sram_arbiter.match_offset` (``2 * max_features + 2``), by
+            :func:`~eyestereo.hdl.system.list_append.list_append`: the host takes features and matches with the
+            feature lists' handshake and reads the matches alone at that word. MATCH sets the threshold, the
+            uniqueness and the left-right check; MATCH_STATUS and MATCH_FAULTS report.
+        match_cost, match_window, match_d_max, match_rows, max_matches: the matcher's cost ("sad" or "census"),
+            window (5, 7, 9, 11; at most ``2 * border + 1``), disparities 0..``match_d_max`` (at most 255), rows
+            searched above and below (R, 0..7: for a calibration that leaves rows off by a pixel), matches per list.
 
     Latency: a frame's features are complete a few lines (Harris's lead, :func:`harris_stereo.latency`)
     after the rectifier's last beat; the sequencer's ``frame_clocks`` measures the whole.
@@ -181,10 +201,19 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     nms = check_choice("nms", nms, NMS_SIZES)
     border = 3 + nms // 2 if border is None else check_int("border", border, 1)
     max_features = check_int("max_features", max_features, 1, 32767)
-    feature_words = check_int("feature_words", feature_words, 2, 65536)
-    if feature_words < 2 * max_features + 2:
+    matcher = check_bool("matcher", matcher)
+    # checked with or without the option (a bad value is refused, not ignored); how they fit the frame only with it
+    match_cost = check_choice("match_cost", match_cost, MATCH_COSTS)
+    match_window = check_choice("match_window", match_window, MATCH_WINDOWS)
+    match_d_max = check_int("match_d_max", match_d_max, 0, MAX_DISPARITY)
+    match_rows = check_int("match_rows", match_rows, 0, MAX_ROWS)
+    max_matches = check_int("max_matches", max_matches, 1, 32767)
+    need = list_words(max_features, max_matches if matcher else None)
+    feature_words = need if feature_words is None else check_int("feature_words", feature_words, 2, 65536)
+    if feature_words < need:
+        what = f" and a match list of {max_matches} matches from word {match_offset(max_features)}" if matcher else ""
         raise block_error(f"parameter feature_words={feature_words}: a list of {max_features} features and its "
-                          f"trailer need {2 * max_features + 2} words")
+                          f"trailer{what} need {need} words")
 
     cam_depth = check_int("cam_depth", cam_depth, 4, MAX_DEPTH)
     if cam_depth & (cam_depth - 1):
@@ -357,8 +386,14 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
         list_in.eof.next = flags.eof
 
     insts += [to_list_valid, to_list_beat]
-    insts.append(feature_list(clk, rst, list_in, feat, c_addr, c_data, tot_l, tot_r, l_ovf, l_done, width=width,
+    f_list = QueuePort(16) if matcher else feat
+    insts.append(feature_list(clk, rst, list_in, f_list, c_addr, c_data, tot_l, tot_r, l_ovf, l_done, width=width,
                               height=height, blocks=BLOCKS, border=border, max_features=max_features))
+    if matcher:
+        insts.append(matcher_option(clk, rst, rect, list_in, f_list, feat, regs, width=width, height=height,
+                                    border=border, lead=harris_latency(nms, 1)[1], cost=match_cost,
+                                    window=match_window, d_max=match_d_max, rows=match_rows,
+                                    max_features=max_features, max_matches=max_matches))
     c_reg = Signal(intbv(0)[16:])
 
     @always_comb
@@ -387,6 +422,42 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
         insts.append(dense_option(clk, rst, rect, hold, regs, bank_host, host, amap=amap, disparities=disparities,
                                   pu=pu, paths=paths))
     return insts
+
+
+@block
+def matcher_option(clk, rst, rect, flags, features, feat, regs, *, width: int, height: int, border: int, lead: int,
+                   cost: str, window: int, d_max: int, rows: int, max_features: int, max_matches: int):
+    """The front end's ``matcher`` option: the hardware matcher on the rectified stream and the flags, its list
+    after the features.
+
+    :func:`~eyestereo.hdl.matching.feature_matcher.feature_matcher` (in the memory clock) takes every rectified
+    pair of ``rect`` and the flags the feature list takes (``flags``: the same beats, the same border); its list
+    and the feature list ``features`` join in :func:`~eyestereo.hdl.system.list_append.list_append` into ``feat``
+    (the feature writer), the matches from word :func:`~eyestereo.tools.models.sram_arbiter.match_offset`. Wired
+    here: MATCH (match_limit, match_uniqueness, match_lr_check), MATCH_STATUS (matches, match_overflow,
+    match_dropped), MATCH_FAULTS (match_late, match_lost). The matcher's own settings: d 0..``d_max``, R = ``rows``,
+    a left table of ``max_features`` corners, 64 slots per store, a pending queue of 32.
+
+    Latency: the match list a few thousand clocks after the frame's last flag (the engine's; docs/matching.md).
+
+    Resources: feature_matcher's (docs/matching.md) and list_append's.
+    """
+    m_list = QueuePort(16)
+    count = Signal(intbv(0)[15:])
+    try:
+        fm = feature_matcher(clk, rst, rect, flags, m_list, regs.match_limit, regs.match_uniqueness,
+                             regs.match_lr_check, regs.match_dropped, regs.match_late, regs.match_lost, cost=cost,
+                             window=window, width=width, height=height, border=border, lead=lead, d_max=d_max,
+                             rows=rows, corners=max_features, max_matches=max_matches)
+    except ValueError as e:
+        raise block_error(f"the matcher option: {str(e).split(': ', 1)[-1]}") from None
+    app = list_append(clk, rst, features, m_list, feat, count, regs.match_overflow, offset=match_offset(max_features))
+
+    @always_comb
+    def status():
+        regs.matches.next = count
+
+    return fm, app, status
 
 
 def dense_fifo(width: int, window: int = DENSE_DEFAULTS["window"]) -> int:

@@ -1,17 +1,12 @@
 """cocotb bench: corner_descriptors against :func:`eyestereo.tools.models.corner_descriptors.corner_descriptors`.
 
-Each frame (``frames``, one spec each) is a pair of grey images and a pair of flag images:
-
-* ``"random:SEED:P"``: random grey levels, each pixel of each camera a corner with probability P (dense
-  flags: corners next to each other, many in one row, the queue under load);
-* ``"pair:LEFT:RIGHT:N"``: two grey images (paths; their centres at the frame size) and the strongest N
-  Harris corners of each (:func:`eyestereo.tools.matching.sparse.detect_corners`) as flags.
-
-The pixels go in as a stereo stream (left and right beat of each pixel, a random idle clock between beats
-with probability ``idle``, ``frame_gap`` idle clocks between frames). The flags are the same beats, each
-coming with the pixel beat ``lag`` beats later (as harris_stereo's flags come with a later input pixel) plus
-``lag_clocks`` clocks (its pipeline, a crossing); the flags left after the last pixel come every
-``tail_spacing`` clocks. ``lag`` is given in rows and pixels: ``lag_rows`` x width + ``lag_pixels``.
+Each frame (``frames``, one spec each: :func:`eyestereo.sim.lib.corner_frames.frame_case`, random flags or
+Harris corners) is a pair of grey images and a pair of flag images. The pixels go in as a stereo stream (a
+random idle clock between beats with probability ``idle``, ``frame_gap`` idle clocks between frames), the
+flags as the same beats, each with the pixel beat ``lag_rows`` rows and ``lag_pixels`` pixels later (as
+harris_stereo's flags come with a later input pixel) plus ``lag_clocks`` clocks (its pipeline, a crossing),
+those left after the last pixel every ``tail_spacing`` clocks
+(:func:`~eyestereo.sim.lib.corner_frames.stream_plan`).
 
 Checked: the descriptor port's beats equal the model's (corners: camera, x, y, last, data; row ends: y and
 eof), no beat has undefined bits, nothing comes after the last frame's last row end, ``late`` and ``lost``
@@ -25,6 +20,7 @@ import numpy as np
 from cocotb.triggers import ReadOnly, RisingEdge, Timer
 
 from eyestereo.sim.lib.bench import load_config, write_report
+from eyestereo.sim.lib.corner_frames import frame_case, stream_plan
 from eyestereo.sim.lib.queue import EdgeClock, drive_intervals, wait_until
 from eyestereo.sim.lib.stream import UNKNOWN, resolved
 from eyestereo.tools.models import corner_descriptors as model
@@ -33,37 +29,6 @@ from eyestereo.tools.models.async_fifo import ClockSpec
 PERIOD_PS = 10_000
 RESET_EDGES = (0, 4)
 PORTS = ("data", "valid", "last", "cam", "x", "y", "row_end", "eof")
-
-
-def frame_case(spec: str, w: int, h: int):
-    """(left image, right image, left flags, right flags) of one frame spec."""
-    kind, *args = spec.split(":")
-    if kind == "random":
-        rng = np.random.default_rng(int(args[0]))
-        p = float(args[1])
-        imgs = rng.integers(0, 256, (2, h, w)).astype(np.uint8)
-        flags = rng.random((2, h, w)) < p
-        return imgs[0], imgs[1], flags[0], flags[1]
-    if kind == "pair":
-        import cv2
-
-        from eyestereo.tools.matching.sparse import detect_corners
-
-        imgs = []
-        for path in args[:2]:
-            img = cv2.imread(path, cv2.IMREAD_GRAYSCALE)
-            if img is None:
-                raise FileNotFoundError(f"cannot read {path}")
-            y0, x0 = (img.shape[0] - h) // 2, (img.shape[1] - w) // 2
-            imgs.append(np.ascontiguousarray(img[y0:y0 + h, x0:x0 + w]))
-        flags = []
-        for img in imgs:
-            f = np.zeros((h, w), bool)
-            xy = np.asarray(detect_corners(img, count=int(args[2])), np.int64).reshape(-1, 2)
-            f[xy[:, 1], xy[:, 0]] = True
-            flags.append(f)
-        return imgs[0], imgs[1], flags[0], flags[1]
-    raise ValueError(f"unknown frame spec {spec!r}")
 
 
 class CornerDescriptorsTB:
@@ -78,40 +43,6 @@ class CornerDescriptorsTB:
         self.source = {n: getattr(dut, f"source_{n}") for n in PORTS}
         self.beats: list[tuple] = []
         self.undefined: list[str] = []
-
-    def schedule(self, cases, start: int) -> tuple[dict, list[int]]:
-        """{edge: {handle: value}} of both streams' beats, and the edge of each frame's last flag beat."""
-        w, h = self.p["width"], self.p["height"]
-        idle, gap = self.cfg.get("idle", 0.0), self.cfg.get("frame_gap", 0)
-        pix, flg = [], []  # (values) in beat order
-        edges = []
-        edge = start
-        for left, right, fl, fr in cases:
-            for y in range(h):
-                for x in range(w):
-                    for cam, img, f in ((0, left, fl), (1, right, fr)):
-                        e = dict(eol=int(x == w - 1), eof=int(x == w - 1 and y == h - 1), cam=cam)
-                        pix.append(dict(data=int(img[y, x]), **e))
-                        flg.append(dict(data=int(f[y, x]), **e))
-                        edges.append(edge)
-                        edge += 1 + int(self.rng.random() < idle)
-            edge += gap
-        lag = 2 * (self.cfg.get("lag_rows", 0) * w + self.cfg.get("lag_pixels", 0))
-        lag_clocks, tail = self.cfg.get("lag_clocks", 3), self.cfg.get("tail_spacing", 1)
-        flag_edges = [(edges[j + lag] if j + lag < len(edges) else edges[-1] + tail * (j + lag - len(edges) + 1))
-                      + lag_clocks for j in range(len(flg))]
-        plan: dict[int, dict] = {}
-        for handles, beats, at in ((self.sink, pix, edges), (self.flags, flg, flag_edges)):
-            for i, (values, e) in enumerate(zip(beats, at)):
-                slot = plan.setdefault(e, {})
-                slot[handles["valid"]] = 1
-                for n, v in values.items():
-                    slot[handles[n]] = v
-                if i + 1 == len(at) or at[i + 1] != e + 1:
-                    plan.setdefault(e + 1, {}).setdefault(handles["valid"], 0)
-        frame_beats = 2 * w * h
-        last_flags = [flag_edges[(f + 1) * frame_beats - 1] for f in range(len(cases))]
-        return plan, last_flags
 
     async def play(self, plan: dict) -> None:
         for e in sorted(plan):
@@ -153,7 +84,7 @@ async def corner_descriptors_frames(dut):
     for handles in (tb.sink, tb.flags):
         for h in handles.values():
             h.value = 0
-    plan, last_flags = tb.schedule(cases, RESET_EDGES[1] + 3)
+    plan, last_flags = stream_plan(tb.sink, tb.flags, cases, RESET_EDGES[1] + 3, cfg, tb.rng)
     cocotb.start_soon(tb.clock.start())
     cocotb.start_soon(drive_intervals(dut.rst, tb.clock, [RESET_EDGES]))
     cocotb.start_soon(tb.play(plan))

@@ -60,7 +60,7 @@ from eyestereo.tools.constants import K_CODE_DEFAULT
 from eyestereo.tools.host_driver import HostDriver
 from eyestereo.tools.models import stereo_frontend as model
 from eyestereo.tools.models.feature_list import parse_words
-from eyestereo.tools.models.sram_arbiter import AddressMap
+from eyestereo.tools.models.sram_arbiter import AddressMap, list_words, match_offset
 from eyestereo.tools.regmap import ARB_WORDS
 from eyestereo.tools.sdram import ULX3S
 from eyestereo.tools.sram import SramPart
@@ -68,7 +68,8 @@ from eyestereo.tools.sram import SramPart
 
 def stereo_frames(spec: str, n: int, width: int, height: int) -> list[tuple[np.ndarray, np.ndarray]]:
     """``n`` stereo pairs of camera words: ``random:S`` (independent random frames), ``shift:S`` (one
-    random scene, the right camera's view shifted by a disparity, the scene moving a pixel per frame) or
+    random scene, the right camera's view shifted by a disparity, the scene moving a pixel per frame),
+    ``match:S`` (the same with the disparity's sign a real rig gives: the matcher option's scene) or
     ``files:LEFT,RIGHT`` (two image files, every frame: :func:`file_pair`)."""
     kind, _, arg = spec.partition(":")
     seed = int(arg or 1) if kind != "files" else 0
@@ -80,6 +81,9 @@ def stereo_frames(spec: str, n: int, width: int, height: int) -> list[tuple[np.n
         elif kind == "shift":
             big = camera_frame(f"random:{seed}", width + 2 * n + 8, height)
             out.append((big[:, i + 8:i + 8 + width].copy(), big[:, i + 4:i + 4 + width].copy()))
+        elif kind == "match":  # as shift, the right view 4 pixels the other way: disparity +4, as a rig sees
+            big = camera_frame(f"random:{seed}", width + 2 * n + 8, height)
+            out.append((big[:, i + 4:i + 4 + width].copy(), big[:, i + 8:i + 8 + width].copy()))
         elif kind == "files":  # a stereo pair of image files, resized to the camera size, every frame
             out.append(out[0] if out else file_pair(arg.split(","), width, height))
         else:
@@ -173,7 +177,9 @@ async def frames_bit_exact(dut):
     # sequential: each frame lets a few camera frames pass (arming, read-out): enough for every one
     n_cam = cfg.get("camera_frames", 5 * n_host + 4)
     dense = bool(cfg["params"].get("dense", False))
-    amap = AddressMap(w, h, cfg["params"].get("feature_words", 2048),
+    msets = match_settings(cfg)
+    amap = AddressMap(w, h, cfg["params"].get("feature_words") or
+                      list_words(mp["max_features"], msets["max_matches"] if msets else None),
                       cameras=cfg["params"].get("rectify", "fetch") != "stream", dense=dense)
     dsets = dense_settings(cfg)
     if cfg.get("pair") is not None:
@@ -217,6 +223,9 @@ async def frames_bit_exact(dut):
     assert await drv.read_thresholds("THR_LEFT") == [thr] * 16
     if dense and cfg.get("dense_settings"):
         await drv.set(**cfg["dense_settings"])
+    if msets:
+        await drv.set(match_limit=msets["limit"], match_uniqueness=msets["uniqueness"],
+                      match_lr_check=int(msets["lr_check"]))
     await ClockCycles(dut.clk, 50)  # the thresholds cross into the Harris clock
 
     for cam, idx in zip(cams, (0, 1)):
@@ -342,6 +351,8 @@ async def frames_bit_exact(dut):
             i += 2
             if a == 0xFFFF or i >= amap.feature_words:
                 break
+        if msets:  # the matcher option: the frame's match list at its fixed word of the same buffer
+            mw = await drv.read_match_list(fbase + match_offset(mp["max_features"]))
         t_read = get_sim_time(unit="ns")
         dut._log.info(f"frame {n}: started {t0 / 1e6:.3f} ms, done {t_frame / 1e6:.3f} ms, read {t_read / 1e6:.3f} ms "
                       f"(simulated), wall {time.time() - wall0:.1f} s")
@@ -354,9 +365,19 @@ async def frames_bit_exact(dut):
         lst = parse_words([(d, False, False) for d in lw[:-1]] + [(lw[-1], True, True)])[0]
         last = dict(rect=rect.tolist(), features=[list(f) for f in lst["features"]])
         ml = model_of(*pl)["list"]  # the model's list of that pair: equal to what the host read
+        if msets:
+            want = match_list_of(model_of(*pl), mp, msets)
+            assert mw == [int(d) for d, _, _ in want["words"]], \
+                f"frame {n}: the match list read ({len(mw)} words) is not the model's ({len(want['words'])} words, " \
+                f"{want['count']} matches): first words {mw[:6]} / {[int(d) for d, _, _ in want['words'][:6]]}"
+            last["matches"] = want["matches"].tolist()
+            results_match = dict(matches=int(want["count"]), candidates=int(want["candidates"]),
+                                 match_words=len(mw))
         results.append(dict(frame=n, rect_pair=pr, list_pair=pl, features=len(lst["features"]),
                             overflow=bool(lst["overflow"]), model_totals=[int(v) for v in ml["totals"]],
                             model_overflow=bool(ml["overflow"]), start_ns=t0, frame_ns=t_frame, read_ns=t_read))
+        if msets:
+            results[-1].update(results_match)
         last_rect, last_list = pr, pl
         # the totals and per-block counts belong to the last complete frame: the list's pair, or a later
         # one in the overlapped mode (the system goes on meanwhile): it must be one of the frames sent
@@ -388,6 +409,8 @@ async def frames_bit_exact(dut):
     arb = await drv.arbiter()
     assert st["dropped_left"] == st["dropped_right"] == 0, st
     assert st["harris_overflows"] == 0, st
+    if msets:
+        assert st["match_dropped"] == st["match_late"] == st["match_lost"] == 0, st
     if dense:
         assert st["dense_overrun"] == 0 and st["disp_lost"] == 0, st
         assert st["disp_frames"] >= len(results), st
@@ -415,6 +438,40 @@ async def frames_bit_exact(dut):
                            arb_words=list(ARB_WORDS), total_ns=get_sim_time(unit="ns") - t_start,
                            camera_frame_pclk=timing.frame_pclk, axi=bus.checker.counts, last=last,
                            stages=stage_times(events, [r["start_ns"] for r in results])))
+
+
+def match_settings(cfg: dict) -> dict | None:
+    """The matcher option's model settings (None without it): the top's parameters (``match_cost``,
+    ``match_window``, ``match_d_max``, ``match_rows``, ``max_matches``, else the top's defaults) and the run-time
+    settings the host writes into MATCH (config ``match``: ``t_max`` or ``h_max``, ``uniqueness``, ``lr_check``;
+    defaults t_max 11, h_max 15, 0, True), with the ``limit`` they give."""
+    p = cfg["params"]
+    if not p.get("matcher"):
+        return None
+    from eyestereo.hdl.system.stereo_frontend import stereo_frontend as top
+    from eyestereo.tools.models.feature_matcher import cost_limit
+
+    sig = inspect.signature(top).parameters
+    top_p = {n: p.get(n, sig[n].default) for n in ("match_cost", "match_window", "match_d_max", "match_rows",
+                                                   "max_matches")}
+    run = dict(dict(t_max=11, h_max=15, uniqueness=0, lr_check=True), **cfg.get("match", {}))
+    return dict(cost=top_p["match_cost"], window=top_p["match_window"], d_max=top_p["match_d_max"],
+                rows=top_p["match_rows"], max_matches=top_p["max_matches"], **run,
+                limit=cost_limit(top_p["match_cost"], top_p["match_window"], run["t_max"], run["h_max"]))
+
+
+def match_list_of(m: dict, mp: dict, ms: dict) -> dict:
+    """The feature matcher model's list for a pair of the front end's model (``m``): its rectified images and the
+    corners of its flags inside the feature list's border."""
+    from eyestereo.tools.models.corner_descriptors import corners
+    from eyestereo.tools.models.feature_matcher import feature_matcher
+    from eyestereo.tools.models.harris_mono import radius
+
+    border = mp["border"] if mp["border"] is not None else radius(mp["nms"])  # the feature list's (the model's rule)
+    fl, fr = (corners(f, border) for f in m["flags"][:2])
+    return feature_matcher(*m["rectified"], fl, fr, window=ms["window"], cost=ms["cost"], t_max=ms["t_max"],
+                           h_max=ms["h_max"], d_min=0, d_max=ms["d_max"], rows=ms["rows"], uniqueness=ms["uniqueness"],
+                           lr_check=bool(ms["lr_check"]), max_matches=ms["max_matches"])
 
 
 def dense_settings(cfg: dict) -> dict | None:

@@ -146,7 +146,8 @@ def test_driver_by_name_on_the_model():
         assert await drv.geometry() == (64, 48)
         await drv.configure(mode="overlapped", continuous=True, k_left=12, thresholds_right=[5, 6, 7])
         assert b.outputs() | {} == dict(mode=1, continuous=1, rect_want=0, feat_want=0, disp_want=0, k_left=12,
-                                        k_right=10, p1=10, p2=30, uniqueness=10, lr_check=1, subpixel=1)
+                                        k_right=10, p1=10, p2=30, uniqueness=10, lr_check=1, subpixel=1,
+                                        match_limit=891, match_uniqueness=0, match_lr_check=1)
         assert (await drv.read_thresholds("THR_RIGHT"))[:4] == [5, 6, 7, 0]
         await drv.set(rect_want=1, feat_want=1)
         assert await drv.read_ctrl() == 0x303  # disp_want (bit 10) not written: configure leaves it

@@ -88,10 +88,14 @@ def test_doc_section_replaced_in_place(tmp_path):
 
 
 def test_block_with_more_ports_than_pins_is_placed_out_of_context(tmp_path):
-    """The register bank (543 port bits with the dense option's fields, more than any ECP5 package's I/O) still
-    gets an fmax, marked so."""
+    """The register bank (613 port bits with the dense and matcher options' fields, more than any ECP5 package's
+    I/O) still gets an fmax, marked so."""
+    import re
+
     r = synth_block("register_bank", tmp_path, pnr=True)
-    assert "out_of_context" in r and "543 port bits" in r["out_of_context"], r.get("ecp5_device")
+    assert "out_of_context" in r, r.get("ecp5_device")
+    m = re.match(r"(\d+) port bits, more than the (\d+) I/O", r["out_of_context"])
+    assert m and int(m.group(1)) > int(m.group(2)), r["out_of_context"]
     assert "--out-of-context" in r["ecp5_device"]
     f = r["fmax"]["clk"]
     assert f["achieved"] is not None and 50.0 < f["achieved"] < 1000.0, f

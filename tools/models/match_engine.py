@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from eyestereo.tools.constants import MATCH_MARKER
 from eyestereo.tools.fixed import sfix, ufix
 from eyestereo.tools.packed import PackedWord
 
@@ -46,7 +47,7 @@ MATCH = PackedWord("match", [("x", ufix(12)), ("dy", sfix(4)), ("y", ufix(12)), 
 #: The end of a frame's list: MARKER, then count | overflow << 15, then the candidates (saturated).
 TRAILER = PackedWord("match list trailer", [("marker", ufix(16)), ("count", ufix(15)), ("overflow", ufix(1)),
                                             ("candidates", ufix(16))])
-MARKER = 0x8000
+MARKER = MATCH_MARKER
 MAX_MATCHES = (1 << 15) - 1
 MAX_ROWS = 7
 MAX_DISPARITY = 255

@@ -18,8 +18,8 @@ from eyestereo.tools.constants import FRAME_HEIGHT, FRAME_WIDTH
 from eyestereo.tools.packed import PackedWord
 from eyestereo.tools.sram import DATA_BITS, WORDS, power_up_word
 
-__all__ = ["AddressMap", "CAMERA_WORD", "RECT_WORD", "Master", "MASTER_TABLE", "MASTERS", "WRITERS",
-           "fetch_addresses", "DoubleBufferModel", "Scoreboard", "STAT"]
+__all__ = ["AddressMap", "match_offset", "list_words", "CAMERA_WORD", "RECT_WORD", "Master", "MASTER_TABLE",
+           "MASTERS", "WRITERS", "fetch_addresses", "DoubleBufferModel", "Scoreboard", "STAT"]
 
 #: A camera word: the pixel's Y in bits 7..0, its chroma sample (U for even x, V for odd x) in 15..8.
 CAMERA_WORD = PackedWord("camera", [("y", 8), ("c", 8)])
@@ -208,6 +208,19 @@ class AddressMap:
 
 #: (dx, dy) of fetch index i: 0 = (x+1, y+1), 1 = (x, y+1), 2 = (x+1, y), 3 = (x, y).
 FETCH_OFFSETS = ((1, 1), (0, 1), (1, 0), (0, 0))
+
+
+def match_offset(max_features: int) -> int:
+    """The word of a feature-list buffer where the front end's matcher option writes the frame's match list: after
+    the longest feature list (2 words per feature) and its trailer (2 words); the words between are filler."""
+    return 2 * max_features + 2
+
+
+def list_words(max_features: int, max_matches: int | None = None) -> int:
+    """The words a feature-list buffer needs: the longest feature list and its trailer, and with the matcher option
+    (``max_matches`` given) the longest match list (3 words per match) and its trailer (3) after
+    :func:`match_offset`."""
+    return match_offset(max_features) + (0 if max_matches is None else 3 * max_matches + 3)
 
 
 def fetch_addresses(amap: AddressMap, base: int, x: int, y: int, mask: int) -> list[tuple[int, int]]:
