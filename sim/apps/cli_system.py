@@ -13,7 +13,13 @@ host driver reads every frame back over AXI4-Lite and compares it with the numpy
 ``OUT/summary.json``; ``--json FILE`` the same figures (frames, fps per mode, SRAM share per master,
 bit_exact). ``--dense D``: the front end built with the dense option (D disparities, below the camera
 width): the host also takes every disparity map (compared bit for bit with the dense model of a rectified
-pair) and ``OUT/disparity.png`` shows the last one (summary: ``dense``). A one-screen summary on stdout.
+pair) and ``OUT/disparity.png`` shows the last one (summary: ``dense``). ``--matcher``: the front end built with
+the hardware matcher (issue 29: SAD 9x9, disparities 0 .. width / 4, the left-right check): the two images are
+taken as a rectified pair and played as the rig's cameras see it (:func:`eyestereo.sim.lib.scenes.camera_views`,
+so that the front end's rectification gives the pair back), every frame's match list is read by the host from
+the list buffer and compared bit for bit with the model, and ``OUT/matches.png`` is drawn from the hardware's
+list of the last frame (summary: ``hardware_matches``: the count and the host's read-out time of the list). A
+one-screen summary on stdout.
 Small frames keep it to a few minutes on 2 cores (GHDL runs the system at a few thousand clocks per second);
 ``--frames`` is 1..64 per mode.
 
@@ -91,6 +97,9 @@ def add_system(sub: Any) -> None:
     p.add_argument("--dense", type=disparities_arg, metavar="D", default=None,
                    help="build the front end with the dense option, D disparities (below the width): the host also "
                         "reads the disparity maps (bit for bit against the model); OUT/disparity.png is the last")
+    p.add_argument("--matcher", action="store_true",
+                   help="build the front end with the hardware matcher: the images are a rectified pair (played as "
+                        "the rig's cameras see it); OUT/matches.png shows the hardware's matches")
     add_build_dir(p)
     p.set_defaults(func=cmd_sim_system)
 
@@ -120,14 +129,12 @@ def _matches_picture(rect: np.ndarray, features, path: Path) -> dict:
     corner, a line to where its right corner lies, coloured by disparity (jet: blue near 0, red at the
     largest); unmatched corners are grey rings. Returns the count of corners and matches and the
     disparities' range (empty lists give no matches, not an error)."""
-    import cv2
-
     from eyestereo.tools.matching.evaluate import DEFAULTS, default_d_max
     from eyestereo.tools.matching.sparse import match_features
 
     left = (rect & 0xFF).astype(np.uint8)
     right = (rect >> 8).astype(np.uint8)
-    h, w = left.shape
+    w = left.shape[1]
     fl = np.array([(x, y) for x, y, cam in features if cam == 0], np.int64).reshape(-1, 2)
     fr = np.array([(x, y) for x, y, cam in features if cam == 1], np.int64).reshape(-1, 2)
     disp = np.zeros(0, np.int64)
@@ -137,6 +144,27 @@ def _matches_picture(rect: np.ndarray, features, path: Path) -> dict:
                            ncc_min=DEFAULTS["ncc_min"], lr_check=DEFAULTS["lr_check"], d_min=0,
                            d_max=default_d_max(w), rows=DEFAULTS["rows"])
         disp, lxy, rxy = m.disparity, m.left, m.right
+    return _draw_matches(left, fl, lxy, rxy, disp, path, [len(fl), len(fr)])
+
+
+def _hardware_matches_picture(rect: np.ndarray, features, matches, dy, path: Path) -> dict:
+    """The hardware's match list of the last frame drawn as :func:`_matches_picture` draws the software's:
+    ``matches`` (x, y, disparity, cost) and ``dy`` (the right corner's row - the left's) as the host read them."""
+    left = (rect & 0xFF).astype(np.uint8)
+    fl = np.array([(x, y) for x, y, cam in features if cam == 0], np.int64).reshape(-1, 2)
+    n_right = sum(1 for *_, cam in features if cam == 1)
+    m = np.asarray(matches, np.int64).reshape(-1, 4)
+    lxy = m[:, :2]
+    rxy = np.stack([m[:, 0] - m[:, 2], m[:, 1] + np.asarray(dy, np.int64)], axis=1)
+    return _draw_matches(left, fl, lxy, rxy, m[:, 2], path, [len(fl), n_right])
+
+
+def _draw_matches(left: np.ndarray, fl, lxy, rxy, disp, path: Path, corners: list[int]) -> dict:
+    """Matches on the left image (see :func:`_matches_picture`); returns the counts and the disparities' range."""
+    import cv2
+
+    h, w = left.shape
+    disp = np.asarray(disp, np.int64)
     s = max(1, 480 // w)
     img = cv2.cvtColor(left, cv2.COLOR_GRAY2BGR)
     img = cv2.resize(img, (w * s, h * s), interpolation=cv2.INTER_NEAREST)
@@ -153,7 +181,7 @@ def _matches_picture(rect: np.ndarray, features, path: Path) -> dict:
     cv2.putText(bar, f"d = 0 .. {d_hi}", (4, 10), cv2.FONT_HERSHEY_SIMPLEX, 0.35, (255, 255, 255), 1)
     if not cv2.imwrite(str(path), np.vstack([img, bar])):
         raise ValueError(f"cannot write {path.name}")
-    return dict(corners=[len(fl), len(fr)], matches=int(len(disp)),
+    return dict(corners=corners, matches=int(len(disp)),
                 disparity=[int(disp.min()), int(disp.max())] if len(disp) else None)
 
 
@@ -171,11 +199,15 @@ def check_bench_packages() -> None:
 
 
 def run_mode(mode: str, work: Path, *, size, frames: int, sim: str,
-             dense: int | None = None) -> tuple[str, dict, Path]:
+             dense: int | None = None, matcher: bool = False) -> tuple[str, dict, Path]:
     """The job (:func:`eyestereo.sim.apps.job.run_jobs`) of one mode's run, in its own folder below ``work``;
-    ``dense``: the dense option's D (None: off)."""
+    ``dense``: the dense option's D (None: off); ``matcher``: the matcher option (disparities 0 .. width / 4)."""
     w, h = size
     extra = {} if dense is None else dict(dense=True, disparities=dense, pu=pu_of(dense))
+    if matcher:
+        from eyestereo.tools.matching.evaluate import default_d_max
+
+        extra.update(matcher=True, match_d_max=default_d_max(w), max_matches=255)
     folder = work / mode
     folder.mkdir()
     return ("eyestereo.sim.lib.runner:run_bench",
@@ -183,14 +215,14 @@ def run_mode(mode: str, work: Path, *, size, frames: int, sim: str,
                  config=dict(mode=mode, frames=frames, pair=[str(work / "left.npy"), str(work / "right.npy")],
                              timing=TIMING),
                  name=f"cli_{mode}_{w}x{h}",
-                 params=dict(quantizers=f"rig:{w}x{h}", feature_words=512, max_features=255, **extra),
+                 params=dict(quantizers=f"rig:{w}x{h}", max_features=255, **extra),
                  build_root=folder / "build", log_file=folder / f"{mode}.log", sim=sim,
                  public=PUBLIC if sim == "verilator" else None),
             folder)
 
 
 def simulate(left: np.ndarray, right: np.ndarray, folder: Path, work: Path, *, size=(48, 32), frames: int = 2,
-             modes=MODES, sim: str = "ghdl", dense: int | None = None) -> dict:
+             modes=MODES, sim: str = "ghdl", dense: int | None = None, matcher: bool = False) -> dict:
     """Run the system on an 8-bit grey pair (any size, resized to ``size``) in ``work`` (a run folder of
     :func:`eyestereo.sim.apps.job.run_folder`) and write the pictures and summary.json into ``folder``;
     returns the summary. :class:`eyestereo.sim.apps.job.JobFailed` when a simulation fails."""
@@ -202,9 +234,15 @@ def simulate(left: np.ndarray, right: np.ndarray, folder: Path, work: Path, *, s
     from eyestereo.tools.io import atomic_write_text
 
     w, h = size
-    for name, img in (("left", left), ("right", right)):
-        np.save(work / f"{name}.npy", cv2.resize(img, (w, h), interpolation=cv2.INTER_AREA).astype(np.uint8))
-    jobs = [run_mode(m, work, size=size, frames=frames, sim=sim, dense=dense) for m in modes]
+    pair = [cv2.resize(img, (w, h), interpolation=cv2.INTER_AREA).astype(np.uint8) for img in (left, right)]
+    if matcher:  # a rectified pair, as the rig's cameras see it: the front end's rectification gives it back
+        from eyestereo.hdl.rectify.calibration import calibration_param
+        from eyestereo.sim.lib.scenes import camera_views
+
+        pair = camera_views(calibration_param(f"rig:{w}x{h}", None, None), *pair)
+    for name, img in zip(("left", "right"), pair):
+        np.save(work / f"{name}.npy", img)
+    jobs = [run_mode(m, work, size=size, frames=frames, sim=sim, dense=dense, matcher=matcher) for m in modes]
     # GHDL: both modes at once (2 cores); a Verilator build already uses both cores: one after the other
     reps = dict(zip(modes, run_jobs(jobs, at_once=1 if sim == "verilator" else 2, what=f"the simulation "
                                     f"({describe(sim)})")))
@@ -212,7 +250,11 @@ def simulate(left: np.ndarray, right: np.ndarray, folder: Path, work: Path, *, s
     figs = {m: figures(r, ct) for m, r in reps.items()}
     last = reps[modes[-1]]["last"]
     _picture(np.array(last["rect"], np.int64), last["features"], folder / "rectified.png")
-    matched = _matches_picture(np.array(last["rect"], np.int64), last["features"], folder / "matches.png")
+    if matcher:
+        matched = _hardware_matches_picture(np.array(last["rect"], np.int64), last["features"], last["matches"],
+                                            last["dy"], folder / "matches.png")
+    else:
+        matched = _matches_picture(np.array(last["rect"], np.int64), last["features"], folder / "matches.png")
     summary = dict(size=f"{w}x{h}", frames={m: len(r["frames"]) for m, r in reps.items()},
                    fps={m: f["fps"] for m, f in figs.items()},
                    sram_share={m: f["sram_share"] for m, f in figs.items()},
@@ -220,6 +262,13 @@ def simulate(left: np.ndarray, right: np.ndarray, folder: Path, work: Path, *, s
                    features_last_frame=len(last["features"]), matches_last_frame=matched,
                    bit_exact=all(r["bit_exact"] for r in reps.values()), simulator=describe(sim),
                    clocks=CLOCKS)
+    if matcher:
+        fr = reps[modes[-1]]["frames"]
+        summary["hardware_matches"] = dict(
+            matches_last_frame=int(fr[-1]["matches"]), candidates_last_frame=int(fr[-1]["candidates"]),
+            match_words_last_frame=int(fr[-1]["match_words"]),
+            read_out_us={m: round(sum(f["match_read_ns"] for f in r["frames"]) / len(r["frames"]) / 1e3, 2)
+                         for m, r in reps.items()})
     if dense is not None:
         codes = np.array(last["disparity"], np.int64)
         valid = codes != INVALID
@@ -233,7 +282,7 @@ def simulate(left: np.ndarray, right: np.ndarray, folder: Path, work: Path, *, s
 
 def main_system(left: Path, right: Path, output: Path, *, size=(48, 32), frames: int = 2, modes=MODES,
                 sim: str | None = None, json_file: Path | None = None, build_dir: Path | None = None,
-                dense: int | None = None) -> dict:
+                dense: int | None = None, matcher: bool = False) -> dict:
     """The command's work for a library caller (``make demo``): check every input, run, write ``output``
     (and ``json_file``) all or nothing; returns the summary. ValueError for bad input or a failed run."""
     from eyestereo.sim.apps.cli_rectify import read_pair
@@ -257,7 +306,7 @@ def main_system(left: Path, right: Path, output: Path, *, size=(48, 32), frames:
         js = out.file(json_file) if json_file is not None else None
         with run_folder("sim-system", build_dir) as work:
             summary = simulate(lg, rg, folder, work, size=size, frames=int(frames), modes=modes, sim=sim,
-                               dense=dense)
+                               dense=dense, matcher=bool(matcher))
         if js is not None:
             js.write_text(json.dumps(summary, indent=2) + "\n")
     return summary
@@ -266,7 +315,8 @@ def main_system(left: Path, right: Path, output: Path, *, size=(48, 32), frames:
 def cmd_sim_system(args) -> int:
     w, h = args.size
     summary = main_system(args.left, args.right, args.output, size=args.size, frames=args.frames, modes=args.modes,
-                          sim=args.sim, json_file=args.json, build_dir=args.build_dir, dense=args.dense)
+                          sim=args.sim, json_file=args.json, build_dir=args.build_dir, dense=args.dense,
+                          matcher=args.matcher)
     print(f"stereo front end, {w}x{h} cameras (18 / 17.9 MHz), memory 100 MHz, Harris 50 MHz "
           f"({summary['simulator']}, simulated time)")
     for m in args.modes:
@@ -277,6 +327,11 @@ def cmd_sim_system(args) -> int:
     print(f"  features in the last frame: {summary['features_last_frame']}, matched {mt['matches']} "
           f"(disparities {mt['disparity']}); bit-exact: {'yes' if summary['bit_exact'] else 'no'}; "
           f"pictures: {args.output}/rectified.png, matches.png")
+    if args.matcher:
+        hm = summary["hardware_matches"]
+        print(f"  hardware matcher: {hm['matches_last_frame']} matches in the last frame's list (drawn in "
+              f"matches.png), {hm['match_words_last_frame']} words; the host read the list in "
+              + ", ".join(f"{m} {v} us" for m, v in hm["read_out_us"].items()) + " (bit for bit the model's)")
     if args.dense is not None:
         d = summary["dense"]
         print(f"  dense: D {d['disparities']}, disparity maps read {sum(d['maps_read'].values())} (each bit for bit "

@@ -100,6 +100,8 @@ async def feature_matcher_frames(dut):
     await Timer(300 * PERIOD_PS, unit="ps")  # then nothing more may come
     assert not mon.undefined, f"undefined bits on the list port: {mon.undefined[:4]}"
     flags = {n: resolved(getattr(dut, n).value) for n in ("dropped", "late", "lost")}
+    if flags != dict(dropped=0, late=0, lost=0):
+        write_report(cfg, dict(frames=len(cases), flags=flags, words=len(mon.beats)))  # what a pace study reads
     assert flags == dict(dropped=0, late=0, lost=0), f"corners were dropped: {flags}"
     got = [(d, eol, eof) for d, eol, eof, _ in mon.beats]
     pos, trailer_edges = 0, []

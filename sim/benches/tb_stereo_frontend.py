@@ -60,6 +60,7 @@ from eyestereo.tools.constants import K_CODE_DEFAULT
 from eyestereo.tools.host_driver import HostDriver
 from eyestereo.tools.models import stereo_frontend as model
 from eyestereo.tools.models.feature_list import parse_words
+from eyestereo.tools.models.match_engine import parse_list
 from eyestereo.tools.models.sram_arbiter import AddressMap, list_words, match_offset
 from eyestereo.tools.regmap import ARB_WORDS
 from eyestereo.tools.sdram import ULX3S
@@ -314,12 +315,50 @@ async def frames_bit_exact(dut):
     wall0 = time.time()
     if mode == "overlapped":
         await drv.start()
+    read = cfg.get("read", "all")
+    if read not in ("all", "matches") or (read == "matches" and not msets):
+        raise ValueError(f"read={read!r}: 'all' (the pair and the lists) or 'matches' (the matcher option's list only)")
+    matches_of = {}  # (digest of the rectified pair) -> the matcher model's list
+
+    def match_model(m):
+        key = (frame_digest(m["rect_words"]), tuple(cur[0]), tuple(cur[1]))
+        if key not in matches_of:
+            matches_of[key] = match_list_of(m, mp, msets)
+        return matches_of[key]
+
     for n in range(n_host):
         t0 = get_sim_time(unit="ns")
         if mode == "sequential":
             await drv.start()
         await drv.wait_frame(after=n, timeout_clocks=timeout, poll_clocks=200)
         t_frame = get_sim_time(unit="ns")
+        if read == "matches":  # the host wants no image and no feature: the list buffer's matches alone
+            await drv.set(feat_want=1)
+            cam_ns = timing.frame_pclk * 1e3 / min(cfg.get("cam_l_mhz", 18.0), cfg.get("cam_r_mhz", 17.9))
+            deadline = get_sim_time(unit="ns") + max(3 * cam_ns, 2e6)
+            while not (st := await drv.status())["feat_held"]:
+                if get_sim_time(unit="ns") > deadline:
+                    raise AssertionError(f"frame {n}: the host never got the lists ({st})")
+                await bus.wait(50)
+            await drv.set(feat_want=0)
+            t_held = get_sim_time(unit="ns")
+            mw = await drv.read_match_list(amap.features(st["feat_buf"]) + match_offset(mp["max_features"]))
+            t_read = get_sim_time(unit="ns")
+            await drv.pulse("feat_release")
+            pl = find(lambda m, mw=mw: [int(d) for d, _, _ in match_model(m)["words"]] == mw, last_list)
+            want, ml = match_model(model_of(*pl)), model_of(*pl)["list"]
+            got = parse_list(mw)  # the hardware's matches, for the picture
+            last = dict(matches=got["matches"].tolist(), dy=got["dy"].tolist())
+            dut._log.info(f"frame {n}: done {t_frame / 1e6:.3f} ms, {got['count']} matches read in "
+                          f"{(t_read - t_held) / 1e3:.1f} us (simulated), wall {time.time() - wall0:.1f} s")
+            # features and overflow: the model's list of the pair the matches belong to (not read: the report's
+            # list_overflows rule needs them)
+            results.append(dict(frame=n, list_pair=pl, features=len(ml["features"]), overflow=bool(ml["overflow"]),
+                                model_totals=[int(v) for v in ml["totals"]], model_overflow=bool(ml["overflow"]),
+                                matches=int(want["count"]), candidates=int(want["candidates"]), match_words=len(mw),
+                                start_ns=t0, frame_ns=t_frame, held_ns=t_held, read_ns=t_read))
+            last_list = pl
+            continue
         await drv.set(rect_want=1, feat_want=1)
         # a pair comes within a camera frame or two (overlapped: the writer may be filling the free buffer); wait
         # three camera frames of the slowest camera (at least 2 ms, the bound before VGA), polling every 50 clocks
@@ -352,7 +391,9 @@ async def frames_bit_exact(dut):
             if a == 0xFFFF or i >= amap.feature_words:
                 break
         if msets:  # the matcher option: the frame's match list at its fixed word of the same buffer
+            t_m = get_sim_time(unit="ns")
             mw = await drv.read_match_list(fbase + match_offset(mp["max_features"]))
+            t_m = get_sim_time(unit="ns") - t_m
         t_read = get_sim_time(unit="ns")
         dut._log.info(f"frame {n}: started {t0 / 1e6:.3f} ms, done {t_frame / 1e6:.3f} ms, read {t_read / 1e6:.3f} ms "
                       f"(simulated), wall {time.time() - wall0:.1f} s")
@@ -370,9 +411,11 @@ async def frames_bit_exact(dut):
             assert mw == [int(d) for d, _, _ in want["words"]], \
                 f"frame {n}: the match list read ({len(mw)} words) is not the model's ({len(want['words'])} words, " \
                 f"{want['count']} matches): first words {mw[:6]} / {[int(d) for d, _, _ in want['words'][:6]]}"
-            last["matches"] = want["matches"].tolist()
+            got = parse_list(mw)  # the hardware's matches (equal to the model's), for the picture
+            last["matches"] = got["matches"].tolist()
+            last["dy"] = got["dy"].tolist()
             results_match = dict(matches=int(want["count"]), candidates=int(want["candidates"]),
-                                 match_words=len(mw))
+                                 match_words=len(mw), match_read_ns=t_m)
         results.append(dict(frame=n, rect_pair=pr, list_pair=pl, features=len(lst["features"]),
                             overflow=bool(lst["overflow"]), model_totals=[int(v) for v in ml["totals"]],
                             model_overflow=bool(ml["overflow"]), start_ns=t0, frame_ns=t_frame, read_ns=t_read))

@@ -32,6 +32,7 @@ speed. Every run's report is kept in build/system/runs/ (``--reuse`` takes them 
     python -m eyestereo.sim.measure.bench_stereo_frontend --single-clock [--size 352x288] [--frames 2] [--frames-ovl 3]
     python -m eyestereo.sim.measure.bench_stereo_frontend --dense [--memory sram] [--rectify fetch] [--frames 1]
         [--frames-ovl 3] [--options-out docs/dense.md]
+    python -m eyestereo.sim.measure.bench_stereo_frontend --matcher [--size 352x288] [--frames 2] [--frames-ovl 3]
     python -m eyestereo.sim.measure.bench_stereo_frontend --real sequential,overlapped [--real-frames 1]
         [--real-pair LEFT RIGHT] [--real-size 352x288] [--real-threshold 16] [--sim verilator] [--reuse]
 """
@@ -301,6 +302,102 @@ def run_real(mode: str, size: str, frames: int, sim: str, *, files=REAL_PAIR, th
     kept.write_text(json.dumps(rep) + "\n")
     print(f"[bench] {tag}: done in {rep['wall_s']} s", flush=True)
     return rep
+
+
+MATCH_TITLE = "## The front end with the matcher option (issue 29)"
+MATCH_THRESHOLD = 4  # threshold code of every block: about 450 corners per camera in Tsukuba, a list of about 910
+
+
+def run_matcher(mode: str, read: str, size: str, frames: int, sim: str, *, reuse: bool = False) -> dict:
+    """One bench run of the top with ``matcher=True`` (SAD 9 x 9, d 0..64, R 0, the MATCH register's reset
+    settings: t_max 11, the left-right check) on Tsukuba as the rig's cameras see it
+    (:func:`eyestereo.sim.lib.scenes.camera_views`: its rectification gives the pair back), lists of 1023
+    features; ``read``: "matches" (the host takes the list buffer only and reads the match list alone) or "all"
+    (the pair, the features and the matches). The report kept in build/system/runs/."""
+    import numpy as np
+
+    from eyestereo.hdl.rectify.calibration import calibration_param
+    from eyestereo.sim.lib.scenes import camera_views
+
+    tag = f"{sim}_matcher_{mode}_{read}_{size}"
+    kept = _kept(tag)
+    if reuse and kept.is_file():
+        rep = json.loads(kept.read_text())
+        if len(rep.get("frames", [])) == frames:
+            return rep
+    RUNS.mkdir(parents=True, exist_ok=True)
+    cal = calibration_param(f"rig:{size}", None, None)
+    views = camera_views(cal, *real_pair_arrays(REAL_PAIR, size))
+    pair = [RUNS / f"matcher_{size}_left.npy", RUNS / f"matcher_{size}_right.npy"]
+    for f, a in zip(pair, views):
+        np.save(f, a)
+    print(f"[bench] {tag}: {frames} frame(s) on {sim_label(sim)} ...", flush=True)
+    revision, dirty, t0 = hdl_revision(), uncommitted_hdl(), time.time()
+    rep = run_bench("stereo_frontend", "tb_stereo_frontend",
+                    dict(mode=mode, frames=frames, pair=[str(f) for f in pair], threshold=MATCH_THRESHOLD,
+                         timing=timing_of(size), require_features=True, read=read),
+                    name=f"bench_matcher_{mode}_{read}_{size}", sim=sim,
+                    params=dict(quantizers=f"rig:{size}", matcher=True),
+                    log_file=RUNS / f"{tag}.log", public=PUBLIC if sim == "verilator" else None)
+    rep.update(wall_s=round(time.time() - t0, 1), simulator=sim_label(sim), revision=revision, uncommitted=dirty,
+               date=datetime.date.today().isoformat(), size=size, read=read, threshold_code=MATCH_THRESHOLD)
+    rep.pop("last", None)
+    kept.write_text(json.dumps(rep) + "\n")
+    print(f"[bench] {tag}: done in {rep['wall_s']} s", flush=True)
+    return rep
+
+
+def matcher_section(reps: list[dict], size: str) -> list[str]:
+    """docs/system.md's section on the matcher option's runs."""
+    w, h = (int(v) for v in size.split("x"))
+    cam = CameraTiming(width=w, height=h, **timing_of(size))
+    rows = []
+    for r in reps:
+        f = figures(r, cam)
+        fr = r["frames"]
+        if r["read"] == "matches":
+            read = [x["read_ns"] - x["held_ns"] for x in fr]
+            words = [x["match_words"] for x in fr]
+            what = "the match list alone"
+        else:
+            read = [x["read_ns"] - x["frame_ns"] for x in fr]
+            words = [w * h + x["match_words"] for x in fr]
+            what = "the pair, the features, the matches"
+        rows.append(f"| {r['mode']} | {what} | {len(fr)} | {f['frames_done']} | {f['period_us'] / 1e3:.2f} ms | "
+                    f"{f['fps']:.2f} | {', '.join(str(x['matches']) for x in fr)} | "
+                    f"{', '.join(str(x['features']) for x in fr)} | {sum(words) / len(words):.0f} | "
+                    f"{sum(read) / len(read) / 1e6:.3f} ms | yes | {r['wall_s']:.0f} s |")
+    rev = reps[0].get("revision", "?") + ("+" if reps[0].get("uncommitted") else "")
+    return [MATCH_TITLE, "",
+            f"`stereo_frontend(matcher=True)` at {size} (the OV6630's timing, cameras 18 / 17.9 MHz), SAD 9 x 9, "
+            "d 0..64, R = 0, the MATCH register's reset settings (t_max 11, the left-right check); the scene is "
+            "Tsukuba (im3, im4 resized) as the rig's cameras see it (`sim/lib/scenes.py`: the rectification gives the "
+            f"pair back), threshold code {MATCH_THRESHOLD} in every block; {reps[0]['simulator']}, HDL revision "
+            f"{rev}. Every match list the host read equals the feature matcher model's for a frame sent (the "
+            "model's rectified pair and flags), word for word; `match_dropped`, `match_late` and `match_lost` 0.", "",
+            "| mode | the host reads | frames read | frames done | frame period | fps | matches | corners listed | "
+            "SRAM words read per frame | host read-out per frame | bit-exact | wall |",
+            "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|", *rows, "",
+            "The read-out is the host's AXI4-Lite reads of the words named (15 bus clocks per SRAM word) from the buffer "
+            "taken to the last word; with the match list alone it is a few hundred words instead of the pair's "
+            f"{w * h} (16.66 ms in the overlapped mode above, the pair and the lists).", ""]
+
+
+def main_matcher(args) -> int:
+    """``--matcher``: the matcher option's runs (overlapped and sequential, the host reading the matches alone), the
+    section spliced into ``--out``."""
+    sim = args.sim or fastest_simulator()
+    try:
+        reps = [run_matcher("overlapped", "matches", args.size, args.frames_ovl, sim, reuse=args.reuse),
+                run_matcher("sequential", "matches", args.size, args.frames, sim, reuse=args.reuse)]
+    except (AssertionError, RuntimeError) as e:
+        print(f"error: a bench run failed ({str(e).splitlines()[0][:200]})", file=sys.stderr)
+        return 1
+    splice_section(args.out, matcher_section(reps, args.size), title=MATCH_TITLE)
+    print(json.dumps([dict(mode=r["mode"], read=r["read"], frames=len(r["frames"]), bit_exact=r["bit_exact"],
+                           fps=figures(r, CameraTiming(**timing_of(args.size)))["fps"], wall_s=r["wall_s"])
+                      for r in reps]))
+    return 0
 
 
 def kept_real(size: str = "352x288") -> list[dict]:
@@ -845,6 +942,9 @@ def main(argv=None) -> int:
                     help="only the single-clock build (stereo_frontend(single_clock=True)), both modes at --size "
                          "(--frames, --frames-ovl); its section of --out is replaced in place")
     ap.add_argument("--reuse", action="store_true", help="take the runs' reports from build/system/runs/ if there")
+    ap.add_argument("--matcher", action="store_true", help="only the matcher option's runs at --size (overlapped "
+                    "--frames-ovl, sequential --frames, the host reading the match lists alone); its section of --out "
+                    "is replaced in place")
     ap.add_argument("--memory", choices=("sram", "sdram"), help="only the top with this frame store, both modes at "
                     "--size; its section of --options-out is replaced in place")
     ap.add_argument("--rectify", choices=("fetch", "stream"), default=None,
@@ -861,6 +961,8 @@ def main(argv=None) -> int:
         return main_options(args)
     if args.real is not None:
         return main_real(args)
+    if args.matcher:
+        return main_matcher(args)
     if args.single_clock:
         return main_single(args)
     if args.frames < 1 or args.frames_ovl < 1:

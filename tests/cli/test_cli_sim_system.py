@@ -115,3 +115,34 @@ def test_matches_picture_colours_the_known_disparity(tmp_path):
     assert m == dict(corners=[5, 5], matches=5, disparity=[5, 5])
     assert cv2.imread(str(tmp_path / "m.png")) is not None
     assert _matches_picture(rect, [], tmp_path / "e.png") == dict(corners=[0, 0], matches=0, disparity=None)
+
+
+@pytest.mark.sim
+@pytest.mark.skipif(shutil.which("ghdl") is None, reason="needs GHDL")
+def test_sim_system_with_the_matcher(cli, tmp_path, pair):
+    """--matcher: the front end with the hardware matcher (the bench compares every match list the host reads with
+    the model); matches.png is the hardware's list, the summary gives its count and the host's read-out time."""
+    lp, rp = pair
+    out = tmp_path / "out"
+    code, so, se = cli("sim", "system", lp, rp, "-o", out, "--size", "48x32", "--frames", "1", "--modes",
+                       "sequential", "--sim", "ghdl", "--matcher")
+    assert code == 0, se
+    fig = json.loads((out / "summary.json").read_text())
+    hm = fig["hardware_matches"]
+    assert fig["bit_exact"] is True and hm["matches_last_frame"] == fig["matches_last_frame"]["matches"] > 0
+    assert hm["match_words_last_frame"] == 3 * hm["matches_last_frame"] + 3
+    assert 0 < hm["read_out_us"]["sequential"] < 1000
+    assert "hardware matcher:" in so and cv2.imread(str(out / "matches.png")) is not None
+
+
+def test_hardware_matches_picture_draws_the_list(tmp_path):
+    """The hardware's list drawn: each match at its left corner, the right corner d to the left and dy below."""
+    import numpy as np
+
+    from eyestereo.sim.apps.cli_system import _hardware_matches_picture
+
+    rect = np.zeros((32, 48), np.int64)
+    feats = [(20, 10, 0), (30, 20, 0), (15, 10, 1)]
+    m = _hardware_matches_picture(rect, feats, [[20, 10, 5, 100], [30, 20, 9, 50]], [0, 1], tmp_path / "h.png")
+    assert m == dict(corners=[2, 1], matches=2, disparity=[5, 9])
+    assert cv2.imread(str(tmp_path / "h.png")) is not None

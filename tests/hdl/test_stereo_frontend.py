@@ -337,18 +337,19 @@ def test_dense_option_parameters_are_checked():
 
 
 @pytest.mark.sim
-@pytest.mark.parametrize("mode", ["sequential", "overlapped"])
-def test_stereo_frontend_matcher(request, mode):
+@pytest.mark.parametrize("mode,read", [("sequential", "all"), ("overlapped", "matches")])
+def test_stereo_frontend_matcher(request, mode, read):
     """matcher=True (issue 29): each frame's match list, after its features in the same list buffer from word
     2 * max_features + 2, equals the feature matcher model's on the model's rectified pair and flags; the host
-    reads it alone (read_match_list), with the features' handshake, after writing MATCH. Tsukuba as both cameras'
-    images (the rig's rectification moves its rows by about a pixel: R = 1)."""
+    reads it (read_match_list) with the features' handshake, after writing MATCH; read="matches": the host takes
+    only the list buffer and reads only the matches (no image, no feature). Tsukuba as both cameras' images (the
+    rig's rectification moves its rows by about a pixel: R = 1)."""
     from eyestereo.tools.dense.datasets import data_dir
 
     t = data_dir() / "middlebury" / "tsukuba"
     rep = run_bench("stereo_frontend", "tb_stereo_frontend",
                     dict(mode=mode, frames=2, images=f"files:{t / 'im3.png'},{t / 'im4.png'}", timing=TIMING,
-                         require_features=True, pause=0.0, adaptive=None, backdoor_rect=True,
+                         require_features=True, pause=0.0, adaptive=None, backdoor_rect=True, read=read,
                          match=dict(t_max=40, lr_check=True)),
                     name=request.node.name, params=dict(quantizers=SPEC, max_features=127, matcher=True,
                                                         match_d_max=12, match_rows=1, max_matches=63))

@@ -146,3 +146,16 @@ def test_bad_settings(change, match):
     kw = dict(cost="sad", window=5, limit=100, d_min=0, d_max=64, rows=0, uniqueness=0, max_matches=10)
     with pytest.raises(ValueError, match=match):
         E.check_engine(**dict(kw, **change))
+
+
+def test_parse_list_reads_back_the_model_words():
+    rng = np.random.default_rng(4)
+    fl = np.array([[10, 3], [20, 3], [30, 5]], np.int64)
+    fr = np.array([[7, 3], [15, 3], [26, 5]], np.int64)
+    a = rng.integers(0, 256, (3, 25))
+    res = E.match_engine(fl, fr, a, a.copy(), width=64, window=5, limit=4096, max_matches=2)
+    got = E.parse_list(res["words"])
+    assert got["matches"].tolist() == res["matches"].tolist() and got["dy"].tolist() == res["dy"].tolist()
+    assert (got["count"], got["overflow"], got["candidates"]) == (res["count"], res["overflow"], res["candidates"])
+    with pytest.raises(ValueError, match="not a match list"):
+        E.parse_list([1, 2, 3, 4])

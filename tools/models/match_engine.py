@@ -36,7 +36,8 @@ from eyestereo.tools.packed import PackedWord
 
 __all__ = ["COSTS", "WINDOWS", "MATCH", "TRAILER", "MARKER", "KEY", "MAX_MATCHES", "MAX_ROWS", "MAX_DISPARITY",
            "MAX_LIMIT", "MATCHED", "NO_CANDIDATE", "OVER_THRESHOLD", "NOT_UNIQUE", "LR_FAILED", "descriptor_words",
-           "word_bits", "cost_bits", "pack_descriptors", "order_key", "candidates", "check_engine", "match_engine"]
+           "word_bits", "cost_bits", "pack_descriptors", "order_key", "candidates", "check_engine", "match_engine",
+           "parse_list"]
 
 COSTS = ("sad", "census")
 #: The window sizes the matcher offers (odd, so the corner is the centre).
@@ -228,3 +229,20 @@ def match_engine(left_xy: np.ndarray, right_xy: np.ndarray, left_desc: np.ndarra
                 count=len(listed), total=len(found), overflow=bool(overflow), candidates=int(len(li)), limit=limit,
                 words=words, best=best, second=second, choice=choice, status=status,
                 pairs=dict(left=li, right=ri, cost=c))
+
+
+def parse_list(words) -> dict:
+    """A match list's words (ints, or ``(data, eol, eof)``; the trailer last) back to ``matches`` ((n, 4) x, y,
+    disparity, cost), ``dy``, ``count``, ``overflow``, ``candidates``; ValueError when the words are not a list."""
+    w = [int(v[0]) if isinstance(v, (tuple, list)) else int(v) for v in words]
+    if len(w) < 3 or len(w) % 3 or w[-3] != MARKER:
+        raise ValueError(f"not a match list: {len(w)} words, want 3 per match and a trailer starting {MARKER:#06x}")
+    n = len(w) // 3 - 1
+    tr = TRAILER.unpack(w[-3] | w[-2] << 16 | w[-1] << 32)
+    if int(tr["count"]) != n:
+        raise ValueError(f"match list of {n} matches, its trailer counts {int(tr['count'])}")
+    packed = np.array([w[3 * i] | w[3 * i + 1] << 16 | w[3 * i + 2] << 32 for i in range(n)], np.int64)
+    f = MATCH.unpack(packed)
+    matches = np.stack([f["x"], f["y"], f["disparity"], f["cost"]], axis=1).reshape(-1, 4).astype(np.int64)
+    return dict(matches=matches, dy=np.asarray(f["dy"], np.int64), count=n, overflow=bool(tr["overflow"]),
+                candidates=int(tr["candidates"]))
