@@ -76,9 +76,9 @@ def corner_descriptors(clk, rst, sink, flags, source, late, lost, *, cost: str =
     Resources: :func:`lines` block RAMs of ``width`` x 16 bits (9 x 9, lead 4: 11 at 352 wide), the queue in
     LUT-RAM, the rotation of ``lines`` bytes into the window's column (a barrel shifter), the output word;
     census ``window`` comparators and the word's ``window**2`` flip-flops. Measured (make synth's flow on this
-    block, the catalogue's configuration: SAD 9 x 9, 352 x 288, lead 4, 32 slots): Yosys xc3se 949 LUT, 562 FF,
-    12 RAMB16 (the 11 buffers and the queue); ECP5 (LFE5U-25F) 582 FF, 11 DP16KD, the queue in LUT-RAM,
-    120.2 / 128.3 / 134.3 MHz (min / median / max of nextpnr seeds 1-4; goal 100 MHz, the memory clock).
+    block, the catalogue's configuration: SAD 9 x 9, 352 x 288, lead 4, 32 slots): Yosys xc3se 1000 LUT, 569 FF,
+    12 RAMB16 (the 11 buffers and the queue); ECP5 (LFE5U-25F) 589 FF, 11 DP16KD, the queue in LUT-RAM,
+    122.6 / 128.8 / 134.6 MHz (min / median / max of nextpnr seeds 1-4; goal 100 MHz, the memory clock).
     """
     check_clock(clk)
     check_reset(rst)

@@ -47,7 +47,10 @@ def feature_matcher(clk, rst, sink, flags, source, limit, uniqueness, lr_check, 
     Latency: a frame's list starts a few hundred clocks after the flags of its last row (the last corners'
     windows, the engine's 2 R rows), then the engine's (its docstring).
 
-    Resources: the two blocks' (their docstrings; docs/matching.md).
+    Resources: the two blocks' (their docstrings; docs/matching.md). Measured (make synth's flow on this block, the
+    catalogue's configuration: SAD 9 x 9, 352 x 288, d 0..64, R 0): Yosys xc3se 2166 LUT + 15 LUT-RAM, 1761 FF,
+    29 RAMB16, 2 MULT18X18; ECP5 (LFE5U-25F) 1598 FF, 26 DP16KD, 2 MULT18X18D, 113.6 / 116.0 / 121.0 MHz (min /
+    median / max of nextpnr seeds 1-4; goal 100 MHz).
     """
     check_clock(clk)
     check_reset(rst)
