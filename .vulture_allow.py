@@ -28,6 +28,7 @@ _._tasks  # sim/lib/stream.py: the monitor's coroutine and its watchers
 # pytest finds these by name
 pytestmark  # tests/*: the module's markers (sim, synth), read by pytest
 pytest_collection_modifyitems  # tests/conftest.py: pytest's collection hook
+pytest_configure  # tests/conftest.py: pytest's configuration hook (registers the run-order plugin)
 
 # tools/sram.py's SramStats counters: only incremented in the library; the benches read them all at once
 # through vars(chip.stats) (sim/benches/tb_sram_subsystem.py: the bus figures of the report)

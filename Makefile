@@ -95,8 +95,14 @@ test-sims: setup
 
 # --dist worksteal: a worker that runs out of tests takes queued ones from the other (with the default
 # scheduler one core sat idle for the last 7 minutes of a 2-worker run while the other ran the SRAM benches).
+# GROUP=k/N: group k of N (1 <= k <= N), pytest-split's groups balanced by tests/durations.json (make test-time
+# records it), so that N machines (a CI matrix) each run one; together they run every test make test runs.
+GROUP  ?=
+SPLIT   = $(if $(GROUP),--splits $(word 2,$(subst /, ,$(GROUP))) --group $(word 1,$(subst /, ,$(GROUP))) \
+          --splitting-algorithm least_duration --durations-path tests/durations.json,)
 test: setup lint
-	$(PY) -m pytest -n $(JOBS) --dist worksteal --durations=60
+	@$(if $(GROUP),$(PY) -m eyestereo.sim.measure.test_groups --check $(GROUP),true)
+	$(PY) -m pytest -n $(JOBS) --dist worksteal --durations=60 $(SPLIT)
 
 # ruff (pycodestyle, pyflakes, bugbear, pyupgrade) and vulture (dead code), configured in pyproject.toml;
 # vulture's known false positives (names only cocotb, MyHDL or pytest call) are listed in .vulture_allow.py

@@ -1,14 +1,31 @@
 import pytest
 
 
+@pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
     # The Icarus/Verilator regressions of every bench (marker othersims) are long: only when -m names them
     # (make test-sims); make test runs the VHDL benches on GHDL and the small three-simulator comparison.
+    # First of the hooks: pytest-split's groups (make test GROUP=k/N) are taken from what is left.
     if "othersims" not in (config.getoption("-m") or ""):
         keep = [it for it in items if not it.get_closest_marker("othersims")]
         if len(keep) != len(items):
             config.hook.pytest_deselected(items=[it for it in items if it.get_closest_marker("othersims")])
             items[:] = keep
+
+
+def pytest_configure(config):
+    config.pluginmanager.register(_LongestFirst(), "eyestereo-longest-first")
+
+
+class _LongestFirst:
+    """The run's order, after every other hook (a group of pytest-split's is ordered as a whole run is)."""
+
+    @pytest.hookimpl(trylast=True)
+    def pytest_collection_modifyitems(self, config, items):
+        _longest_first(config, items)
+
+
+def _longest_first(config, items):
     # Longest first, so that the workers finish together: each test's recorded time (tests/durations.json, a
     # suite run's --durations), else a guess by kind (a bench a few seconds, the rest little).
     dur = _durations()

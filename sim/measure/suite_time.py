@@ -3,8 +3,9 @@
 ``python -m eyestereo.sim.measure.suite_time [--out docs/suite.md] [--jobs 2]`` runs the suite exactly as
 ``make test`` does (``pytest -n JOBS --dist worksteal``), in a child process, and records its wall time,
 the CPU time of all its processes (workers and simulators), the number of tests, and the slowest tests
-by pytest's own ``--durations``; every test's time (of a second or more) goes to ``tests/durations.json``, by
-which ``tests/conftest.py`` starts the longest tests first. Measure on a quiet machine: tests run beside other
+by pytest's own ``--durations``; every test's time (setup, call and teardown) goes to ``tests/durations.json``, by
+which ``tests/conftest.py`` starts the longest tests first and ``make test GROUP=k/N`` (pytest-split) balances its
+groups. Measure on a quiet machine: tests run beside other
 work take several times longer. The document is written only after a run in which every test passed.
 """
 
@@ -30,8 +31,8 @@ SLOWEST = 15
 
 
 def run(jobs: int) -> dict:
-    cmd = [sys.executable, "-m", "pytest", "-n", str(jobs), "--dist", "worksteal", "--durations=0", "-q",
-           "-p", "no:cacheprovider"]
+    cmd = [sys.executable, "-m", "pytest", "-n", str(jobs), "--dist", "worksteal", "--durations=0",
+           "--durations-min=0", "-q", "-p", "no:cacheprovider"]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
@@ -43,7 +44,7 @@ def run(jobs: int) -> dict:
     slow = re.findall(r"^([\d.]+)s (call|setup|teardown)\s+(\S+)", out, re.M)
     every: dict[str, float] = {}
     for sec, _, test in slow:
-        every[test] = round(every.get(test, 0.0) + float(sec), 1)
+        every[test] = round(every.get(test, 0.0) + float(sec), 2)
     return dict(rc=r.returncode, wall=wall, cpu=cpu, summary=summary[-1][0] if summary else "?",
                 pytest_s=float(summary[-1][1]) if summary else None, slow=slow[:SLOWEST], every=every,
                 cmd=" ".join(cmd[2:]),
@@ -75,7 +76,7 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "suite.md")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--durations", type=Path, default=ROOT / "tests" / "durations.json",
-                    help="every test's time of at least a second, which tests/conftest.py orders the suite by")
+                    help="every test's time, which tests/conftest.py orders the suite by and pytest-split groups it by")
     args = ap.parse_args(argv)
     if args.jobs < 1:
         print("suite_time: --jobs must be at least 1", file=sys.stderr)
@@ -86,8 +87,7 @@ def main(argv=None) -> int:
               "\n".join(res["tail"]), file=sys.stderr)
         return 1
     publish(document(res, args.jobs), args.out)
-    atomic_write_text(args.durations, json.dumps({k: v for k, v in sorted(res["every"].items()) if v >= 1.0},
-                                                 indent=0) + "\n")
+    atomic_write_text(args.durations, json.dumps(dict(sorted(res["every"].items())), indent=0) + "\n")
     return 0
 
 
