@@ -51,6 +51,8 @@ def list_append(clk, rst, sink, matches, source, count, overflow, *, offset: int
     ``ready`` from ``source.ready``); the filler words come one per clock the consumer takes.
 
     Resources: a 16-bit word counter, a two-bit state, the last word and the count registers, the multiplexer.
+    Measured (make synth's flow on this block, offset 2048): Yosys xc3se 59 LUT, 46 FF; ECP5 197.2 / 228.3 / 237.0
+    MHz (min / median / max of nextpnr seeds 1-4; goal 100 MHz, the memory clock).
     """
     check_clock(clk)
     check_reset(rst)

@@ -20,7 +20,7 @@ import numpy as np
 from cocotb.triggers import ReadOnly, RisingEdge, Timer
 
 from eyestereo.sim.lib.bench import load_config, write_report
-from eyestereo.sim.lib.corner_frames import frame_case, stream_plan
+from eyestereo.sim.lib.corner_frames import frame_case, play_plan, stream_plan
 from eyestereo.sim.lib.queue import EdgeClock, drive_intervals, wait_until
 from eyestereo.sim.lib.stream import UNKNOWN, resolved
 from eyestereo.tools.models import corner_descriptors as model
@@ -43,12 +43,6 @@ class CornerDescriptorsTB:
         self.source = {n: getattr(dut, f"source_{n}") for n in PORTS}
         self.beats: list[tuple] = []
         self.undefined: list[str] = []
-
-    async def play(self, plan: dict) -> None:
-        for e in sorted(plan):
-            await wait_until(self.clock.before(e))
-            for handle, v in plan[e].items():
-                handle.value = v
 
     async def monitor(self) -> None:
         clk, src = self.dut.clk, self.source
@@ -87,7 +81,7 @@ async def corner_descriptors_frames(dut):
     plan, last_flags = stream_plan(tb.sink, tb.flags, cases, RESET_EDGES[1] + 3, cfg, tb.rng)
     cocotb.start_soon(tb.clock.start())
     cocotb.start_soon(drive_intervals(dut.rst, tb.clock, [RESET_EDGES]))
-    cocotb.start_soon(tb.play(plan))
+    cocotb.start_soon(play_plan(tb.clock, plan))
     await wait_until(tb.clock.spec.time(RESET_EDGES[1]) + 1)  # the outputs are defined from the reset on
     cocotb.start_soon(tb.monitor())
     await wait_until(tb.clock.spec.time(max(plan) + 50 * p["width"]))

@@ -20,8 +20,8 @@ import numpy as np
 from cocotb.triggers import Timer
 
 from eyestereo.sim.lib.bench import load_config, write_report
-from eyestereo.sim.lib.corner_frames import frame_case, stream_plan
-from eyestereo.sim.lib.queue import EdgeClock, QueueMonitor, drive_intervals, wait_until
+from eyestereo.sim.lib.corner_frames import check_match_lists, frame_case, play_plan, stream_plan
+from eyestereo.sim.lib.queue import EdgeClock, QueueMonitor, drive_intervals, random_stalls, wait_until
 from eyestereo.sim.lib.stream import resolved
 from eyestereo.tools.models.async_fifo import ClockSpec
 from eyestereo.tools.models.corner_descriptors import corners
@@ -50,23 +50,9 @@ class FeatureMatcherTB:
                                d_max=p["d_max"], rows=p["rows"], uniqueness=c.get("uniqueness", 0),
                                lr_check=c.get("lr_check", False), max_matches=p["max_matches"])
 
-    async def play(self, plan: dict) -> None:
-        for e in sorted(plan):
-            await wait_until(self.clock.before(e))
-            for handle, v in plan[e].items():
-                handle.value = v
-
     def stalls(self, until: int) -> list[tuple[int, int]]:
         """Random (first, end) edge intervals with ``ready`` low (config ``stall``: the share of edges)."""
-        share = self.cfg.get("stall", 0.0)
-        out, e = [], RESET_EDGES[1] + 2
-        while share and e < until:
-            length = int(self.rng.integers(1, 12))
-            gap = max(1, int(length * (1 - share) / share * self.rng.uniform(0.5, 1.5)))
-            e += gap
-            out.append((e, e + length))
-            e += length + 1
-        return out
+        return random_stalls(self.rng, self.cfg.get("stall", 0.0), RESET_EDGES[1] + 2, until)
 
 
 @cocotb.test()
@@ -87,7 +73,7 @@ async def feature_matcher_frames(dut):
     cocotb.start_soon(tb.clock.start())
     cocotb.start_soon(drive_intervals(dut.rst, tb.clock, [RESET_EDGES]))
     cocotb.start_soon(drive_intervals(dut.source_ready, tb.clock, tb.stalls(horizon), active=0))
-    cocotb.start_soon(tb.play(plan))
+    cocotb.start_soon(play_plan(tb.clock, plan))
     await wait_until(tb.clock.spec.time(RESET_EDGES[1]) + 1)  # the outputs are defined from the reset on
     cocotb.start_soon(tb.monitor.run())
 
@@ -103,20 +89,8 @@ async def feature_matcher_frames(dut):
     if flags != dict(dropped=0, late=0, lost=0):
         write_report(cfg, dict(frames=len(cases), flags=flags, words=len(mon.beats)))  # what a pace study reads
     assert flags == dict(dropped=0, late=0, lost=0), f"corners were dropped: {flags}"
-    got = [(d, eol, eof) for d, eol, eof, _ in mon.beats]
-    pos, trailer_edges = 0, []
-    for f, e in enumerate(expected):
-        want = [(int(d), bool(a), bool(b)) for d, a, b in e["words"]]
-        part = got[pos:pos + len(want)]
-        if part != want:
-            i = next((i for i, (a, b) in enumerate(zip(part, want)) if a != b), min(len(part), len(want)))
-            raise AssertionError(f"frame {f}: {len(part)} words out, the model's {len(want)}; first difference at "
-                                 f"word {i}: got {part[i] if i < len(part) else None}, want "
-                                 f"{want[i] if i < len(want) else None} (model: {e['count']} matches, "
-                                 f"{e['candidates']} candidates)")
-        pos += len(want)
-        trailer_edges.append(mon.beats[pos - 1][3])
-    assert pos == len(got), f"{len(got) - pos} words after the last frame's trailer: {got[pos:pos + 3]}"
+    trailer_edges = check_match_lists(mon.beats, expected)
+    pos = len(mon.beats)
     write_report(cfg, dict(frames=len(cases), words=pos, matches=[e["count"] for e in expected],
                            candidates=[e["candidates"] for e in expected],
                            corners=[[int(len(corners(c[2], p["border"]))), int(len(corners(c[3], p["border"])))]

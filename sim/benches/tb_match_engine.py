@@ -26,7 +26,8 @@ import numpy as np
 from cocotb.triggers import Timer
 
 from eyestereo.sim.lib.bench import load_config, write_report
-from eyestereo.sim.lib.queue import EdgeClock, QueueMonitor, drive_intervals, wait_until
+from eyestereo.sim.lib.corner_frames import check_match_lists
+from eyestereo.sim.lib.queue import EdgeClock, QueueMonitor, drive_intervals, random_stalls, wait_until
 from eyestereo.sim.lib.stream import resolved
 from eyestereo.tools.models import match_engine as model
 from eyestereo.tools.models.async_fifo import ClockSpec
@@ -147,15 +148,7 @@ class MatchEngineTB:
 
     def stalls(self, until: int) -> list[tuple[int, int]]:
         """Random (first, end) edge intervals with ``ready`` low (config ``stall``: the share of edges)."""
-        share = self.cfg.get("stall", 0.0)
-        out, e = [], RESET_EDGES[1] + 2
-        while share and e < until:
-            length = int(self.rng.integers(1, 12))
-            gap = max(1, int(length * (1 - share) / share * self.rng.uniform(0.5, 1.5)))
-            e += gap
-            out.append((e, e + length))
-            e += length + 1
-        return out
+        return random_stalls(self.rng, self.cfg.get("stall", 0.0), RESET_EDGES[1] + 2, until)
 
 
 @cocotb.test()
@@ -201,20 +194,8 @@ async def match_engine_frames(dut):
         import json
         with open(cfg["dump"], "w") as fh:
             json.dump(dict(got=[w for w, _, _ in got], want=[[int(d) for d, _, _ in e["words"]] for e in expected]), fh)
-    pos = 0
-    trailer_edges = []
-    for f, e in enumerate(expected):
-        want = [(int(d), bool(a), bool(b)) for d, a, b in e["words"]]
-        part = got[pos:pos + len(want)]
-        if part != want:
-            i = next((i for i, (a, b) in enumerate(zip(part, want)) if a != b), min(len(part), len(want)))
-            raise AssertionError(f"frame {f}: {len(part)} words out, the model's {len(want)}; first difference at "
-                                 f"word {i}: got {part[i] if i < len(part) else None}, want "
-                                 f"{want[i] if i < len(want) else None} (model: {e['count']} matches, "
-                                 f"{e['candidates']} candidates)")
-        pos += len(want)
-        trailer_edges.append(mon.beats[pos - 1][3])
-    assert pos == len(got), f"{len(got) - pos} words after the last frame's trailer: {got[pos:pos + 3]}"
+    trailer_edges = check_match_lists(mon.beats, expected)
+    pos = len(got)
     lat = [t - e for t, e in zip(trailer_edges, ends)]
     write_report(cfg, dict(frames=len(cases), words=pos, dropped=False, matches=[e["count"] for e in expected],
                            candidates=[e["candidates"] for e in expected],

@@ -2,7 +2,8 @@
 
 ``frame_case`` makes a frame from a spec; ``stream_plan`` schedules the pixels and the flags of frames as
 harris_stereo's would come: the flags lag the pixels by whole rows and pixels of beats plus a pipeline's
-clocks, and the flags left after the last pixel come as a tail.
+clocks, and the flags left after the last pixel come as a tail; ``play_plan`` drives such a schedule;
+``check_match_lists`` compares the match lists a bench read with the model's, frame by frame.
 """
 
 from __future__ import annotations
@@ -107,3 +108,35 @@ def stream_plan(sink: dict, flags: dict, cases, start: int, cfg: dict, rng) -> t
                 plan.setdefault(e + 1, {}).setdefault(handles["valid"], 0)
     frame_beats = 2 * w * h
     return plan, [flag_edges[(f + 1) * frame_beats - 1] for f in range(len(cases))]
+
+
+async def play_plan(clock, plan: dict) -> None:
+    """Drive ``plan`` ({edge: {handle: value}}, :func:`stream_plan`'s) half a period before each edge of ``clock``
+    (a :class:`~eyestereo.sim.lib.queue.EdgeClock`)."""
+    from eyestereo.sim.lib.queue import wait_until
+
+    for e in sorted(plan):
+        await wait_until(clock.before(e))
+        for handle, v in plan[e].items():
+            handle.value = v
+
+
+def check_match_lists(beats, expected) -> list[int]:
+    """The words a :class:`~eyestereo.sim.lib.queue.QueueMonitor` recorded (``beats``) against each frame's model
+    list (``expected``: match_engine / feature_matcher results, their ``words``) in order, nothing after the
+    last; AssertionError at the first difference. Returns the edge of each frame's last word (its trailer)."""
+    got = [(d, eol, eof) for d, eol, eof, _ in beats]
+    pos, trailer_edges = 0, []
+    for f, e in enumerate(expected):
+        want = [(int(d), bool(a), bool(b)) for d, a, b in e["words"]]
+        part = got[pos:pos + len(want)]
+        if part != want:
+            i = next((i for i, (a, b) in enumerate(zip(part, want)) if a != b), min(len(part), len(want)))
+            raise AssertionError(f"frame {f}: {len(part)} words out, the model's {len(want)}; first difference at "
+                                 f"word {i}: got {part[i] if i < len(part) else None}, want "
+                                 f"{want[i] if i < len(want) else None} (model: {e['count']} matches, "
+                                 f"{e['candidates']} candidates)")
+        pos += len(want)
+        trailer_edges.append(beats[pos - 1][3])
+    assert pos == len(got), f"{len(got) - pos} words after the last frame's trailer: {got[pos:pos + 3]}"
+    return trailer_edges

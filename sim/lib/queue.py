@@ -58,6 +58,19 @@ async def wait_until(t_ps: int) -> None:
         await Timer(t_ps - now, unit="ps")
 
 
+def random_stalls(rng, share: float, start: int, until: int) -> list[tuple[int, int]]:
+    """Random ``(first, end)`` edge intervals from ``start`` to ``until`` covering about ``share`` of the edges
+    (stretches of 1..11 edges), for :func:`drive_intervals` on a consumer's ``ready`` (0: none)."""
+    out, e = [], start
+    while share and e < until:
+        length = int(rng.integers(1, 12))
+        gap = max(1, int(length * (1 - share) / share * rng.uniform(0.5, 1.5)))
+        e += gap
+        out.append((e, e + length))
+        e += length + 1
+    return out
+
+
 async def drive_intervals(signal, clock: EdgeClock, intervals, *, active: int = 1) -> None:
     """Hold ``signal`` at ``active`` at the edges of each ``(first, end)`` interval, else at the other level.
 

@@ -15,7 +15,9 @@ def test_register_bank_against_table(request):
     rep = run_bench("register_bank", "tb_register_bank", dict(seed=3, pause=0.3), name=request.node.name,
                     params=dict(width=64, height=48))
     assert rep["counts"]["ar"] > 300 and rep["gaps"] > 100
-    assert rep["host_requests"] > 20  # the SRAM window's share of the random accesses falls as the table grows
+    # the bench counts the SRAM window's host port requests exactly (a write of the upper bytes alone makes none):
+    # at least its 16 reads
+    assert rep["host_requests"] >= 16
 
 
 # ---- elaboration: ports checked, port list from the table (no simulator needed for these) -----------

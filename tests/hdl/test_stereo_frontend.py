@@ -336,14 +336,19 @@ def test_dense_option_parameters_are_checked():
             writer(**kw)
 
 
-@pytest.mark.sim
-@pytest.mark.parametrize("mode,read", [("sequential", "all"), ("overlapped", "matches")])
-def test_stereo_frontend_matcher(request, mode, read):
+@pytest.mark.parametrize("mode,read,sim", [pytest.param("sequential", "all", None, marks=pytest.mark.sim),
+                                           pytest.param("overlapped", "matches", None, marks=pytest.mark.sim),
+                                           pytest.param("overlapped", "all", "verilator",
+                                                        marks=pytest.mark.othersims),
+                                           pytest.param("sequential", "matches", "icarus",
+                                                        marks=pytest.mark.othersims)])
+def test_stereo_frontend_matcher(request, mode, read, sim):
     """matcher=True (issue 29): each frame's match list, after its features in the same list buffer from word
     2 * max_features + 2, equals the feature matcher model's on the model's rectified pair and flags; the host
     reads it (read_match_list) with the features' handshake, after writing MATCH; read="matches": the host takes
     only the list buffer and reads only the matches (no image, no feature). Tsukuba as both cameras' images (the
-    rig's rectification moves its rows by about a pixel: R = 1)."""
+    rig's rectification moves its rows by about a pixel: R = 1). The GHDL runs in make test, MyHDL's Verilog on
+    Verilator and Icarus in make test-sims."""
     from eyestereo.tools.dense.datasets import data_dir
 
     t = data_dir() / "middlebury" / "tsukuba"
@@ -351,8 +356,9 @@ def test_stereo_frontend_matcher(request, mode, read):
                     dict(mode=mode, frames=2, images=f"files:{t / 'im3.png'},{t / 'im4.png'}", timing=TIMING,
                          require_features=True, pause=0.0, adaptive=None, backdoor_rect=True, read=read,
                          match=dict(t_max=40, lr_check=True)),
-                    name=request.node.name, params=dict(quantizers=SPEC, max_features=127, matcher=True,
-                                                        match_d_max=12, match_rows=1, max_matches=63))
+                    name=request.node.name, sim=sim,
+                    params=dict(quantizers=SPEC, max_features=127, matcher=True, match_d_max=12, match_rows=1,
+                                max_matches=63))
     assert rep["bit_exact"] and len(rep["frames"]) == 2
     assert all(f["match_words"] == 3 * f["matches"] + 3 for f in rep["frames"])
     assert all(f["candidates"] > 3 for f in rep["frames"]) and sum(f["matches"] for f in rep["frames"]) > 0
