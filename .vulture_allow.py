@@ -53,3 +53,9 @@ HarrisWindowTB  # sim/benches/tb_harris_window.py
 _.description  # ErrorMeasure.description: the metric's one-line text for reports
 _.coarse_error  # PolyFFC.coarse_error: the error of the coarse search, before the greedy refinement
 _.coarse_trace  # PolyFFC.coarse_trace: (bits, error) of each coarse step
+
+# MyHDL user-defined code (sim/harnesses/frontend_harness.py): the templates name the block's locals, MyHDL reads the
+# attributes by name when it converts
+file_name  # camera_player's $file_name in its verilog_code / vhdl_code templates
+_.verilog_code  # the user-defined Verilog of camera_player and sram_part
+_.vhdl_code  # the user-defined VHDL of camera_player and sram_part

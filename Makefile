@@ -10,7 +10,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-$(shell (cat pyproject.toml 2>/dev/null || echo none) | cksum | cut -d' ' -f1)
 JOBS   ?= 2
 
-.PHONY: all setup ghdl ccache simulator vhdl verilog sim test test-sims test-time demo synth timing regs report bench formal architecture interfaces lint clean distclean help
+.PHONY: all setup ghdl ccache simulator vhdl verilog sim test test-sims test-time soak demo synth timing regs report bench formal architecture interfaces lint clean distclean help
 
 all: test
 
@@ -113,6 +113,13 @@ lint: setup
 # make test timed (wall and CPU time, slowest tests) into docs/suite.md; measure on a quiet machine
 test-time: setup
 	$(PY) -m eyestereo.sim.measure.suite_time --out docs/suite.md --jobs $(JOBS)
+
+# The fault soak (issue 25; not in make test): the complete front end on the fast harness (Verilator), 1,200
+# small and 32 full 352x288 frames under camera and host faults, every frame bit-exact, the faults' rules checked,
+# coverage merged -> docs/reliability.md (about a quarter of an hour on 2 cores). SOAK=--quick: two short runs.
+SOAK ?=
+soak: setup
+	$(PY) -m eyestereo.sim.measure.soak --jobs $(JOBS) $(SOAK)
 
 # SymbiYosys proofs (k-induction, or bounded where stated) and covers of the property sets in formal/, then
 # their mutants, each of which must be rejected (docs/formal.md); make test runs the fast jobs (about 3 min),

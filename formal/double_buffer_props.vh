@@ -65,6 +65,8 @@ always @(*) if (f_past && !rst && f_took) begin
     assert(side_c_held);
     assert(side_c_buf ? f_full1_p : f_full0_p);
     if (f_full0_p && f_full1_p) assert(side_c_buf == f_last_p);
+    // and the older FULL one is gone (FREE, or WRITING if the producer started on it): never taken after it
+    if (f_full0_p && f_full1_p) assert((side_c_buf ? f_st0 : f_st1) != F_FULL);
 end
 
 // the producer's pick: never the buffer the consumer holds or takes; a FREE one before a FULL one; of two

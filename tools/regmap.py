@@ -397,6 +397,10 @@ REGISTERS: tuple[Register, ...] = (
              (_f("match_late", 0, 16, "corners whose flag came after their window had left the line buffers",
                  connect=_MATCH + " late"),
               _f("match_lost", 16, 16, "corners that found the pending queue full", connect=_MATCH + " lost"))),
+    Register("LOST", 0x048, "status", "frames the sequencer gave up",
+             (_f("lists_lost", 0, 16, "rectified frames whose feature lists never came (a Harris-domain reset cut "
+                 "them): given up by the sequencer's list watchdog after list_timeout clocks",
+                 connect=_SEQ + " lists_lost"),)),
     Register("THR_LEFT", 0x100, "array", "pre-threshold of each 4x4 block of the left image, index by*4 + bx "
              "(20-bit cornerness code; 0 after reset)",
              (_f("thr_left", 0, THRESHOLD_BITS, "threshold code",

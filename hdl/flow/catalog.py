@@ -146,6 +146,9 @@ class BlockSpec:
     source_type: type = ImageStream
     #: clock ports with the thesis's goal in MHz (None: none, or the default of eyestereo.hdl.flow.synth)
     clocks: tuple[tuple[str, float | None], ...] = (("clk", None),)
+    #: bench tops only: hand-written test models simulated beside the conversion, function(language: "vhdl" or
+    #: "verilog") -> {file name: text} (written into the conversion's folder, compiled before the top)
+    sources: Callable[[str], dict[str, str]] | None = None
 
     def params(self, **overrides) -> dict:
         unknown = set(overrides) - set(self.defaults)

@@ -80,11 +80,15 @@ def convert(name: str, path: Path, *, hdl: str = "VHDL", entity: str | None = No
         warnings.simplefilter("ignore")
         extra = dict(timescale=timescale) if (timescale and hdl.lower() == "verilog") else {}
         inst.convert(hdl=hdl, name=entity, path=str(path), initial_values=True, **extra)
+    models = []
+    for fname, text in (spec.sources(hdl.lower()) if spec.sources else {}).items():
+        (path / fname).write_text(text)
+        models.append(path / fname)
     if hdl == "VHDL":
         vhd = path / f"{entity}.vhd"
         vhd.write_text(vhdl93_literals(vhd.read_text()))
-        return sorted(path.glob("pck_myhdl_*.vhd")) + [vhd]
-    return [path / f"{entity}.v"]
+        return sorted(path.glob("pck_myhdl_*.vhd")) + models + [vhd]
+    return models + [path / f"{entity}.v"]
 
 
 def vhdl_ports(vhd: Path) -> list[dict]:

@@ -7,6 +7,7 @@ the SRAM (the address map: :class:`eyestereo.tools.models.sram_arbiter.AddressMa
     FREE --producer starts a frame--> WRITING --its last word is issued--> FULL --consumer takes--> READING
       ^                                  |                                   |                          |
       +----------- aborted (token) ------+      a newer frame overwrites ----+      consumer releases --+
+                                                or is taken (the older FULL) -+
 
 * A producer starting a frame takes a buffer that is neither being written nor read: a FREE one if
   there is one, else the older FULL one (the newest frame is kept for the consumer). The block would
@@ -19,7 +20,8 @@ the SRAM (the address map: :class:`eyestereo.tools.models.sram_arbiter.AddressMa
   half-written frame: the fetch port and the host address only buffers a consumer holds.
 * The consumer *takes* the newest FULL buffer (``c_take``, when ``c_avail``) and holds it (READING,
   ``c_held``, ``c_buf``) until it releases it (``c_release``); a frame published meanwhile waits FULL.
-  A take wins over a producer's start in the same clock.
+  A take wins over a producer's start in the same clock. When both are FULL the take frees the older one
+  (counted as overwritten): a consumer never gets a frame older than one it has had.
 
 Both operating modes of the complete system use this one handshake (:class:`FrameControl`):
 
@@ -218,6 +220,15 @@ def double_buffer(clk, rst, side: BufferSide):
                 s1.next = READING
             else:
                 s0.next = READING
+            # Two FULL: the older one is stale once the newer is taken (a consumer must never get a frame older
+            # than one it already had: the fault soak found a late camera's older frame paired after a newer
+            # one). It is freed and counted as overwritten, unless the producer starts on it in this clock.
+            if s0 == FULL and s1 == FULL and not (starting and p_pick != take_buf):
+                overwritten.next = overwritten + 1
+                if take_buf:
+                    s0.next = FREE
+                else:
+                    s1.next = FREE
 
     @always_comb
     def outputs():

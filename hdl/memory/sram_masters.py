@@ -242,11 +242,12 @@ def camera_in(clk, rst, q, push, entry, count, run, arm, *, depth: int):
     """A camera's queue read port into the writer FIFO (``entry``: :class:`EntrySignals`).
 
     A frame is captured when it starts while ``run`` is high or the camera is armed (an ``arm`` pulse,
-    used up by the next frame captured); otherwise its words are taken and discarded. A reset token
-    (``eof`` without ``eol``) in a captured frame becomes an abort entry. ``ready`` comes from the FIFO
-    count register only.
+    used up by the next frame captured *whole*); otherwise its words are taken and discarded. A reset token
+    (``eof`` without ``eol``) in a captured frame becomes an abort entry, and an arm that frame used up is
+    given back: the next frame is captured instead (the fault soak found the sequential mode waiting for ever
+    after one broken camera frame). ``ready`` comes from the FIFO count register only.
     """
-    take, want, in_frame, cap, armed = (Signal(bool(0)) for _ in range(5))
+    take, want, in_frame, cap, armed, by_arm = (Signal(bool(0)) for _ in range(6))
     token, first = entry.abt, entry.sof
     wires = pack_word(entry.word, ENTRY, data=q.data, eof=q.eof, **entry.flags())
 
@@ -270,9 +271,12 @@ def camera_in(clk, rst, q, push, entry, count, run, arm, *, depth: int):
             armed.next = True
         if token:
             in_frame.next = False
+            if in_frame and cap and by_arm:
+                armed.next = True  # the broken frame gives its arm back
         elif take:
             if first:
                 cap.next = want
+                by_arm.next = armed
                 if want and not arm:
                     armed.next = False
                 in_frame.next = not q.eof

@@ -1,6 +1,6 @@
 """Front-end sequencer: the two operating modes of the stereo front end (thesis 7.1), start/stop, counters."""
 
-from myhdl import Signal, always_seq, block, enum, intbv
+from myhdl import Signal, always_comb, always_seq, block, enum, intbv
 
 from eyestereo.hdl.common.checks import check_clock, check_reset, check_signal
 from eyestereo.hdl.memory.frame_buffers import FrameControl
@@ -11,7 +11,8 @@ __all__ = ["frontend_sequencer"]
 
 @block
 def frontend_sequencer(clk, rst, mode, continuous, start, stop, ctl, rect_start, rect_busy, list_done,
-                       list_overflow, busy, frames, frame_clocks, list_overflows, ready=None):
+                       list_overflow, busy, frames, frame_clocks, list_overflows, ready=None, lists_lost=None, *,
+                       list_timeout: int | None = None):
     """Drives the camera side of the frame handshake and the rectifier's ``start`` for the two modes.
 
     * **sequential** (``mode`` 0, the thesis's estimate): each stereo frame is one stage after the
@@ -41,14 +42,25 @@ def frontend_sequencer(clk, rst, mode, continuous, start, stop, ctl, rect_start,
         busy: output, 1 bit; frames, frame_clocks: outputs, 32 bits; list_overflows: output, 16 bits.
         ready: optional input, 1 bit: the frame store is ready (an SDRAM after its power-up sequence); a
             ``start`` before it is kept (``busy`` high) and taken once it is. None: always ready.
+        lists_lost: optional output, 16 bits: rectified frames whose lists the watchdog gave up (None: not
+            counted outside).
 
-    Parameters: none.
+    Parameters:
+        list_timeout: None (default): the lists of every rectified frame are waited for, however long (the
+            formal properties' environment: one ``list_done`` per rectified frame). An int (memory clocks,
+            1..2**24): the *list watchdog*: while the sequencer waits for lists (sequential: after the
+            rectification; both modes: draining after a stop) and no ``list_done`` has come for that many clocks,
+            the frames still pending are given up (counted in ``lists_lost``) and the sequencer goes on as if
+            they were complete. A Harris-domain reset can cut a frame whose lists then never come (the fault
+            soak found the front end busy for ever after one); the timeout must exceed the Harris pipeline's
+            latency from the rectifier's end to the lists (stereo_frontend's default: :func:`list_timeout`).
 
     Latency: the rectifier starts one clock after the pair is held; the pair is released one clock
     after the rectifier's ``busy`` falls (its last fetch has been answered by then); the next pair is
     looked for once ``cam_held`` of the released one has fallen.
 
-    Resources: a state register, two 32-bit counters and a 32-bit clock counter, a 16-bit counter.
+    Resources: a state register, two 32-bit counters and a 32-bit clock counter, two 16-bit counters, the list
+    watchdog's counter (log2 list_timeout bits; none without it).
     """
     check_clock(clk)
     check_reset(rst)
@@ -65,6 +77,14 @@ def frontend_sequencer(clk, rst, mode, continuous, start, stop, ctl, rect_start,
         ready = Signal(bool(1))  # undriven: a constant 1 in the VHDL
     else:
         check_signal("ready", ready, width=1)
+    if list_timeout is not None and (isinstance(list_timeout, bool) or not isinstance(list_timeout, int)
+                                     or not 1 <= list_timeout <= 1 << 24):
+        raise ValueError(f"list_timeout must be None or an int of clocks in 1..2**24, got {list_timeout!r}")
+    limit = 0 if list_timeout is None else int(list_timeout)  # 0: no watchdog
+    if lists_lost is not None:
+        check_signal("lists_lost", lists_lost, width=16)
+    wd = Signal(intbv(0, min=0, max=limit + 2))   # clocks the lists have been waited for without a list_done
+    nlost = Signal(intbv(0)[16:])
     pend = Signal(bool(0))  # a start waiting for the frame store
     st_t = enum("IDLE", "ARM", "PAIR", "RSTART", "RFIRST", "RECT", "REL", "LISTS", "DRAIN")
     st = Signal(st_t.IDLE)
@@ -151,6 +171,22 @@ def frontend_sequencer(clk, rst, mode, continuous, start, stop, ctl, rect_start,
         elif done_now and not started:
             if pending > 0:
                 pending.next = pending - 1
+        # the list watchdog (limit 0: none): lists waited for and none come for `limit` clocks -> given up
+        waiting = st == st_t.LISTS or (st == st_t.DRAIN and pending != 0)
+        if limit != 0 and waiting and not done_now:
+            if wd == limit:
+                wd.next = 0
+                nlost.next = nlost + pending
+                pending.next = 0
+                if st == st_t.LISTS and more and not stop:
+                    t.next = 0
+                    st.next = st_t.ARM
+                else:
+                    st.next = st_t.IDLE
+            else:
+                wd.next = wd + 1
+        else:
+            wd.next = 0
         if done_now:
             frame_clocks.next = t + 1 if st == st_t.LISTS else t
             if md and st != st_t.LISTS:
@@ -162,4 +198,11 @@ def frontend_sequencer(clk, rst, mode, continuous, start, stop, ctl, rect_start,
         frames.next = nframes
         list_overflows.next = novf
 
-    return fsm, outputs
+    insts = [fsm, outputs]
+    if lists_lost is not None:
+        @always_comb
+        def lost_out():
+            lists_lost.next = nlost
+
+        insts.append(lost_out)
+    return insts

@@ -27,6 +27,7 @@ from eyestereo.hdl.dense.dense_stereo import dense_stereo
 from eyestereo.hdl.dense.sgm import PU_CHOICES
 from eyestereo.hdl.system.disparity_writer import disparity_writer
 from eyestereo.hdl.system.list_append import list_append
+from eyestereo.hdl.system.threshold_replay import threshold_replay
 from eyestereo.hdl.matching.feature_matcher import feature_matcher
 from eyestereo.hdl.harris.harris_stereo import latency as harris_latency
 from eyestereo.tools.models.match_engine import COSTS as MATCH_COSTS, WINDOWS as MATCH_WINDOWS, MAX_DISPARITY, MAX_ROWS
@@ -70,6 +71,14 @@ THR_BITS = REGMAP["THR_LEFT"].fields[0].width
 CAM_DEPTH = FIFO_DEPTH
 
 
+def default_list_timeout(width: int) -> int:
+    """The list watchdog's default (memory clocks): 128 per pixel of a line, at least 16384. The lists come a few
+    lines after the rectifier's end (CIF: 5,700 clocks measured, 16 clocks per pixel of a line; the matcher's list
+    up to 3,241 clocks after the last flag); the default leaves eight times that, and stays right for a Harris
+    clock down to half the memory clock."""
+    return max(128 * int(width), 16384)
+
+
 @block
 def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sram, *, quantizers="rig",
                     frac: int | None = unit_model.DEFAULT_FRAC, nms: int = NMS_DEFAULT, border: int | None = None,
@@ -79,7 +88,8 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
                     memory: str = "sram", sdram_part: str = ULX3S, dense: bool = False,
                     disparities: int = DENSE_DEFAULTS["disparities"], pu: int = 4,
                     paths: int = DENSE_DEFAULTS["paths"], matcher: bool = False, match_cost: str = "sad",
-                    match_window: int = 9, match_d_max: int = 64, match_rows: int = 0, max_matches: int = 1023):
+                    match_window: int = 9, match_d_max: int = 64, match_rows: int = 0, max_matches: int = 1023,
+                    list_timeout: int | None = None):
     """The complete stereo front end of the thesis's Fig. 7.2, with the processor's register bus.
 
     Data flow: each camera bus -> :func:`~eyestereo.hdl.camera.camera_interface.camera_pair` (converter and
@@ -175,6 +185,13 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
         match_cost, match_window, match_d_max, match_rows, max_matches: the matcher's cost ("sad" or "census"),
             window (5, 7, 9, 11; at most ``2 * border + 1``), disparities 0..``match_d_max`` (at most 255), rows
             searched above and below (R, 0..7: for a calibration that leaves rows off by a pixel), matches per list.
+        list_timeout: the sequencer's list watchdog
+            (:func:`~eyestereo.hdl.system.frontend_sequencer.frontend_sequencer`):
+            memory clocks without a ``list_done`` after which the lists of the frames waited for are given up
+            (counted in LOST.lists_lost); default :func:`default_list_timeout` (128 clocks per pixel of a line, at least
+            16384: 45,056 at CIF, eight times the lists' measured 5,700 after the rectifier). A Harris-domain reset
+            (``hrst``) can cut a frame whose lists then never come; without the watchdog the front end stayed busy
+            for ever (found by the fault soak, docs/reliability.md).
 
     Latency: a frame's features are complete a few lines (Harris's lead, :func:`harris_stereo.latency`)
     after the rectifier's last beat; the sequencer's ``frame_clocks`` measures the whole.
@@ -316,7 +333,9 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     l_done, l_ovf = Signal(bool(0)), Signal(bool(0))
     insts.append(frontend_sequencer(clk, rst, regs.mode, regs.continuous, regs.start, regs.stop, sctl, r_start,
                                     r_busy, l_done, l_ovf, regs.busy, regs.frames, regs.frame_clocks,
-                                    regs.list_overflows, mem_ready))
+                                    regs.list_overflows, mem_ready, regs.lists_lost,
+                                    list_timeout=default_list_timeout(width) if list_timeout is None
+                                    else list_timeout))
 
     # ---- into the Harris clock and back (or, single_clock, straight) ------------------------------------
     hclk_, hrst_ = (clk, rst) if single_clock else (hclk, hrst)
@@ -344,13 +363,12 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
     @always_comb
     def to_harris_m():
         k_m.next = concat(regs.k_right, regs.k_left)
-        thr_m.valid.next = regs.thr_left_we or regs.thr_right_we
-        thr_m.eol.next = 1
-        thr_m.eof.next = 1
-        if regs.thr_left_we:
-            thr_m.data.next = concat(False, regs.thr_left_addr, regs.thr_left_data)
-        else:
-            thr_m.data.next = concat(True, regs.thr_right_addr, regs.thr_right_data)
+
+    # the thresholds as one-beat frames, and all 32 again after a reset of the Harris domain alone (its reset
+    # clears harris_stereo's table; the soak found the frames after it thresholded at 0: threshold_replay)
+    insts.append(threshold_replay(clk, rst, Signal(bool(0)) if single_clock else hrst, regs.thr_left_we,
+                                  regs.thr_left_addr, regs.thr_left_data, regs.thr_right_we, regs.thr_right_addr,
+                                  regs.thr_right_data, thr_m))
 
     @always_comb
     def to_harris_h():

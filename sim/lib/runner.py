@@ -91,7 +91,16 @@ def cached_convert(block: str, build_dir: Path, cache: Path | None = None, **kw)
     :data:`CONVERT_CACHE`). Parameters that are not plain data (objects, files) are converted every time."""
     if os.environ.get("EYESTEREO_CONVERT_CACHE", "1") == "0" or not _plain(kw):
         return convert(block, build_dir, **kw)
-    key = hashlib.sha1(json.dumps([block, kw, _source_key()], sort_keys=True).encode()).hexdigest()[:20]
+    from eyestereo.hdl.flow.catalog import get
+
+    spec = get(block)
+    models = {lang: spec.sources(lang) for lang in ("vhdl", "verilog")} if spec.sources else None
+    # a bench top's own module (sim/harnesses) is not in hdl/ or tools/: its text joins the key
+    import inspect
+
+    func = getattr(spec.func, "func", spec.func)  # MyHDL's @block wraps the function
+    own = Path(inspect.getsourcefile(func)).read_text()
+    key = hashlib.sha1(json.dumps([block, kw, _source_key(), models, own], sort_keys=True).encode()).hexdigest()[:20]
     root = CONVERT_CACHE if cache is None else Path(cache)
     entry = root / key
     listing = entry / "files.json"

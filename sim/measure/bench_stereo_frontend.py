@@ -242,7 +242,7 @@ def real_pair_arrays(files, size: str):
 def real_model(left, right, size: str, threshold: int, max_features: int) -> dict:
     """What the model finds in the pair (the bench's chain and parameters): per camera totals, listed, overflow."""
     from eyestereo.hdl.rectify.calibration import calibration_param
-    from eyestereo.sim.benches.tb_stereo_frontend import model_params
+    from eyestereo.sim.lib.frontend_model import model_params
     from eyestereo.tools.camera import yuv_frame
     from eyestereo.tools.models import stereo_frontend as model
     from eyestereo.tools.models.harris_mono import k_code

@@ -83,7 +83,7 @@ ROOMS = {
     # so apps never import measure; a bench imports no other bench (test_bench_imports_no_other_bench)
     "sim": set(),
     "sim/lib": TOOLS | HDL,
-    "sim/harnesses": TOOLS | HDL,
+    "sim/harnesses": TOOLS | HDL | {"sim/lib"},
     "sim/benches": TOOLS | HDL | {"sim/lib"},
     "sim/apps": TOOLS | HDL | {"sim/lib"},
     "sim/measure": TOOLS | HDL | {"sim/lib", "sim/benches", "sim/harnesses", "sim/apps"},
@@ -100,7 +100,8 @@ TIERS = [
     {"hdl/matching"},
     {"hdl/system"},
     {"hdl/flow", "hdl"},
-    {"sim", "sim/lib", "sim/harnesses"},
+    {"sim", "sim/lib"},
+    {"sim/harnesses"},
     {"sim/benches", "sim/apps"},
     {"sim/measure"},
 ]

@@ -218,7 +218,7 @@ def test_bench_models_with_the_tops_parameters():
     import inspect
 
     from eyestereo.hdl.system.stereo_frontend import stereo_frontend as top
-    from eyestereo.sim.benches.tb_stereo_frontend import MODEL_PARAMS, model_params
+    from eyestereo.sim.lib.frontend_model import MODEL_PARAMS, model_params
 
     sig = inspect.signature(top).parameters
     assert model_params({}) == {k: sig[k].default for k in MODEL_PARAMS}
@@ -234,7 +234,7 @@ def test_pair_and_files_give_the_same_frames(tmp_path):
     pictures give the same camera words, every frame; a wrong array is refused with its size."""
     import cv2
 
-    from eyestereo.sim.benches.tb_stereo_frontend import pair_frames, stereo_frames
+    from eyestereo.sim.lib.frontend_model import pair_frames, stereo_frames
 
     npy = real_scene(tmp_path)
     pngs = []
