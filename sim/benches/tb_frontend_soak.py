@@ -168,6 +168,14 @@ async def soak(dut):
         at = [sum(1 for x in st if x <= p) - 1 for st, p in ((starts_l, played[0]), (starts_r, played[1]))]
         out.sort(key=lambda e: e["t_ns"])
         return f"faults in the last 12 camera frames: {out}; the cameras at frames {at}"
+    async def until_idle(what: str) -> None:
+        """Wait until busy falls after a stop (the watchdog: ``settle`` camera frames)."""
+        dl = get_sim_time(unit="ns") + settle * cam_ns
+        while (st := await drv.status())["busy"]:
+            assert get_sim_time(unit="ns") < dl, f"hang: busy stays high after {what}: {st}; " \
+                f"{recent(get_sim_time(unit='ns'))}"
+            await tb.bus.wait(poll)
+
     if mode == "overlapped":
         await drv.start()
     reads, last = [], (-1, -1)
@@ -262,11 +270,7 @@ async def soak(dut):
             pending_write = True
         elif host_fault == "mode_change":
             await drv.stop()
-            dl = get_sim_time(unit="ns") + settle * cam_ns
-            while (stt := await drv.status())["busy"]:
-                assert get_sim_time(unit="ns") < dl, f"hang: busy stays high after stop (mode change): {stt}; " \
-                    f"{recent(get_sim_time(unit='ns'))}"
-                await tb.bus.wait(poll)
+            await until_idle("mode change")
             new = "sequential" if mode == "overlapped" else "overlapped"
             sk.event("mode_change", mode=mode, to=new)
             mode = new
@@ -288,11 +292,7 @@ async def soak(dut):
                 cocotb.start_soon(pulse_reset(dut.hrst, int(round(1e6 / cfg.get("harris_mhz", 50.0))), after))
     if mode == "overlapped":
         await drv.stop()
-    dl = get_sim_time(unit="ns") + settle * cam_ns
-    while (stt := await drv.status())["busy"]:
-        assert get_sim_time(unit="ns") < dl, f"hang: busy stays high after the final stop: {stt}; " \
-            f"{recent(get_sim_time(unit='ns'))}"
-        await tb.bus.wait(poll)
+    await until_idle("the final stop")
     stt = await drv.status()
     t_end = get_sim_time(unit="ns")
     # the camera faults played: a frame whose schedule began before the end (its samples from go on)

@@ -35,6 +35,7 @@ from pathlib import Path
 
 from eyestereo.sim.lib.frontend_runs import PUBLIC as OLD_PUBLIC
 from eyestereo.sim.lib.runner import ROOT, hdl_revision, run_bench
+from eyestereo.tools.io import write_section
 
 RUNS = ROOT / "build" / "system" / "fast"
 BEGIN, END = "<!-- fast_system: begin -->", "<!-- fast_system: end -->"
@@ -128,19 +129,6 @@ def table(reports: list[dict]) -> list[str]:
     return out + ["", END]
 
 
-def write(out: Path, lines: list[str]) -> None:
-    text = out.read_text()
-    block = "\n".join(lines)
-    if BEGIN in text and END in text:
-        head, rest = text.split(BEGIN, 1)
-        text = head + block + rest.split(END, 1)[1]
-    else:
-        text = text.rstrip("\n") + "\n\n## Fast whole-system simulation (issue 25)\n\n" + block + "\n"
-    tmp = out.with_suffix(".tmp")
-    tmp.write_text(text)
-    tmp.replace(out)
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--frames", type=int, default=3, help="frames read per Verilator run (both benches)")
@@ -158,8 +146,8 @@ def main(argv=None) -> int:
             ap.error(f"--{name.replace('_', '-')} must be >= 0")
     if a.frames < 1 or a.jobs < 1:
         ap.error("--frames and --jobs must be at least 1")
-    if not a.out.is_file():
-        ap.error(f"{a.out} does not exist (the section goes into the system page)")
+    if BEGIN not in (a.out.read_text() if a.out.is_file() else ""):
+        ap.error(f"{a.out} has no '{BEGIN}' ... '{END}' section to fill")
     JOBS[0] = a.jobs
     jobs = [("old", "verilator", a.frames), ("fast", "verilator", a.frames)]
     if a.ghdl_frames:
@@ -175,7 +163,8 @@ def main(argv=None) -> int:
     except AssertionError as e:
         print(f"bench_fast_system: a run failed: {e}", file=sys.stderr)
         return 1
-    write(a.out, table(reports))
+    lines = table(reports)  # the markers first and last
+    write_section(a.out, "\n".join(lines[1:-1]) + "\n", BEGIN, END)
     print("\n".join(table(reports)))
     return 0
 

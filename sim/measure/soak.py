@@ -24,6 +24,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from eyestereo.sim.lib.runner import ROOT, hdl_revision, run_bench
+from eyestereo.tools.io import write_section
 
 BUILD = ROOT / "build" / "soak"
 BEGIN, END = "<!-- soak: begin -->", "<!-- soak: end -->"
@@ -68,7 +69,7 @@ def run_one(r: dict, reuse: bool = False) -> dict:
     rep = run_bench("frontend_harness", "tb_frontend_soak", cfg, name=f"soak_{r['name']}", sim="verilator",
                     params=dict(quantizers=f"rig:{r['size']}", feature_words=512, max_features=255),
                     log_file=BUILD / f"{r['name']}.log", public=PUBLIC)
-    rep["run"] = dict(r, wall_total_s=round(time.time() - t0, 1))
+    rep["run"] = dict(r, wall_total_s=round(time.time() - t0, 1), hdl=hdl_revision())
     from eyestereo.sim.lib.runner import build_dir_of
 
     shutil.copy2(build_dir_of("frontend_harness", f"soak_{r['name']}", "verilator") / "coverage.yml",
@@ -87,7 +88,7 @@ def section(reports: list[dict], cov_lines: list[str], holes: list, quick: bool)
     full = sum(r["frames_read"] for r in reports if r["width"] * r["height"] >= 352 * 288)
     out = [BEGIN, "",
            f"Measured by `python -m eyestereo.sim.measure.soak{' --quick' if quick else ''}` (generated; do not edit) "
-           f"on {datetime.date.today().isoformat()}, HDL {hdl_revision()}: the fast harness on Verilator, "
+           f"on {datetime.date.today().isoformat()}, HDL {_revisions(reports)}: the fast harness on Verilator, "
            f"{small} small frames and {full} full 352x288 frames read, every one bit-exact, no hang.", "",
            "### The faults and what the system must do (written before the soak ran: `sim/lib/soak.py`)", "",
            "| fault | by | injected | expected (checked by the soak bench) |", "|---|---|---|---|"]
@@ -134,21 +135,13 @@ def section(reports: list[dict], cov_lines: list[str], holes: list, quick: bool)
     return out + ["", END]
 
 
+def _revisions(reports: list[dict]) -> str:
+    """The HDL revision(s) the runs measured (recorded by each run; today's for a run kept without one)."""
+    return ", ".join(sorted({r["run"].get("hdl") or hdl_revision() for r in reports}))
+
+
 def _bounds(b) -> str:
     return ", ".join(f"{side} {lo}" if lo == hi else f"{side} {lo}..{hi}" for side, (lo, hi) in zip("LR", b))
-
-
-def write_section(out: Path, lines: list[str]) -> None:
-    text = out.read_text() if out.exists() else "# Reliability\n"
-    block = "\n".join(lines)
-    if BEGIN in text and END in text:
-        head, rest = text.split(BEGIN, 1)
-        text = head + block + rest.split(END, 1)[1]
-    else:
-        text = text.rstrip("\n") + "\n\n## The fault soak\n\n" + block + "\n"
-    tmp = out.with_suffix(".tmp")
-    tmp.write_text(text)
-    tmp.replace(out)
 
 
 def main(argv=None) -> int:
@@ -160,6 +153,8 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     if a.jobs < 1:
         ap.error(f"--jobs must be at least 1, got {a.jobs}")
+    if BEGIN not in (a.out.read_text() if a.out.is_file() else ""):
+        ap.error(f"{a.out} has no '{BEGIN}' ... '{END}' section to fill")
     plan = QUICK if a.quick else PLAN
     from eyestereo.sim.lib import soak_coverage as cov
 
@@ -173,7 +168,8 @@ def main(argv=None) -> int:
     reports.sort(key=lambda rep: order.index(rep["run"]["name"]))
     merged = cov.merge([BUILD / f"{r['name']}.coverage.yml" for r in plan], BUILD / "coverage.yml")
     lines, holes = cov.report(merged)
-    write_section(a.out, section(reports, lines, holes, a.quick))
+    text = section(reports, lines, holes, a.quick)  # the markers first and last
+    write_section(a.out, "\n".join(text[1:-1]) + "\n", BEGIN, END)
     print(f"soak: {sum(r['frames_read'] for r in reports)} frames read in {len(reports)} runs, all bit-exact; "
           f"{len(holes)} coverage holes; {a.out} written")
     return 0
