@@ -59,3 +59,20 @@ _.coarse_trace  # PolyFFC.coarse_trace: (bits, error) of each coarse step
 file_name  # camera_player's $file_name in its verilog_code / vhdl_code templates
 _.verilog_code  # the user-defined Verilog of camera_player and sram_part
 _.vhdl_code  # the user-defined VHDL of camera_player and sram_part
+
+# sim/lib/sccb.py: SccbRules's fields are read by name (SccbRules.ps(name), the rule names in its messages)
+_.t_cyc  # SccbSlave._rise: "t_cyc"
+_.t_low  # SccbSlave._rise: "t_low"
+_.t_high  # SccbSlave._fall: "t_high"
+_.t_su_sta  # SccbSlave._start: "t_su_sta"
+_.t_hd_sta  # SccbSlave._fall: "t_hd_sta"
+_.t_su_dat  # SccbSlave._rise: "t_su_dat"
+_.t_su_sto  # SccbSlave._stop: "t_su_sto"
+_.t_buf  # SccbSlave._start: "t_buf"
+_.t_aa  # SccbBus._drive: "t_aa"
+_.reset_wait  # SccbSlave._start: "reset_wait"
+
+# sim/benches/tb_board.py: the SDRAM model reads its pins by name (getattr(dut, f"{prefix}_{field}"))
+_.pins_dq_o  # sim/benches/tb_board.py SdramPins: read by SdramModel as dut.pins_dq_o
+_.pins_dq_oe  # sim/benches/tb_board.py SdramPins: read by SdramModel as dut.pins_dq_oe
+_.pins_dq_i  # sim/benches/tb_board.py SdramPins: written by SdramModel as dut.pins_dq_i

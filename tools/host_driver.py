@@ -223,8 +223,20 @@ class HostDriver:
     async def read_sram_words(self, word: int, count: int) -> list[int]:
         """``count`` SRAM words from word address ``word`` (through the host port); a range that leaves
         the SRAM window is refused before the first read
-        (:meth:`~eyestereo.tools.regmap.Register.check_words`)."""
-        return [await self.read("SRAM", i) for i in self.regmap["SRAM"].check_words(word, count)]
+        (:meth:`~eyestereo.tools.regmap.Register.check_words`). A bus with ``read_burst`` (the board's serial
+        link, :class:`eyestereo.tools.board.serial_bus.SerialBus`) reads them in bursts; BusError on a response
+        that is not OKAY."""
+        r = self.regmap["SRAM"]
+        words = r.check_words(word, count)
+        if not hasattr(self.bus, "read_burst") or count == 0:
+            return [await self.read("SRAM", i) for i in words]
+        # a bus with bursts (the board's serial link): one request per 256 words instead of one per word
+        out = []
+        for k, (data, resp) in enumerate(await self.bus.read_burst(r.address(words[0]), count)):
+            if resp != 0:
+                raise BusError(f"{r.label(words[k])}: read response {resp} (not OKAY)")
+            out.append(int(data))
+        return out
 
     async def take_disparity(self, amap, *, timeout_clocks: int = 10_000_000, poll_clocks: int = 50) -> list[int]:
         """The dense option's newest disparity map: take it (CTRL.disp_want until STATUS.disp_held), read its
@@ -268,8 +280,13 @@ class HostDriver:
         r = self.regmap["SRAM"]
         values = list(values)
         words = [(i, r.check_value(v, i)) for i, v in zip(r.check_words(word, len(values)), values)]
-        for i, v in words:
-            await self.write("SRAM", v, i)
+        if not hasattr(self.bus, "write_burst") or not words:
+            for i, v in words:
+                await self.write("SRAM", v, i)
+            return
+        for k, resp in enumerate(await self.bus.write_burst(r.address(words[0][0]), [v for _, v in words])):
+            if resp != 0:
+                raise BusError(f"{r.label(words[k][0])}: write response {resp} (not OKAY)")
 
 
 def _accessors(regmap: RegisterMap) -> None:

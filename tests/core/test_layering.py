@@ -43,13 +43,14 @@ FORBIDDEN = {
 # The table
 
 #: Every part of tools (``core`` = its top-level modules): any room of hdl and sim may import them.
-TOOLS = {"tools/core", "tools/models", "tools/rectify", "tools/matching", "tools/dense", "tools/cli", "tools/reports"}
+TOOLS = {"tools/core", "tools/models", "tools/rectify", "tools/matching", "tools/dense", "tools/cli", "tools/reports",
+         "tools/board"}
 #: The rooms of hdl that hold blocks (and the port bundles and helpers they are made of).
 BLOCKS = {f"hdl/{r}" for r in ("interfaces", "common", "streaming", "harris", "rectify", "camera", "memory", "axi",
-                                 "dense", "matching")}
+                                 "dense", "matching", "video", "serial")}
 #: All of hdl: the block rooms, the top, the EDA flow and the package itself (``eyestereo.hdl``, which
 #: re-exports the blocks).
-HDL = BLOCKS | {"hdl/system", "hdl/flow", "hdl"}
+HDL = BLOCKS | {"hdl/system", "hdl/boards", "hdl/flow", "hdl"}
 
 #: room -> the rooms it may import (besides itself). The rows of hdl and sim are docs/architecture.md's tables.
 ROOMS = {
@@ -61,8 +62,10 @@ ROOMS = {
     "tools/matching": {"tools/core", "tools/models"},
     # dense stereo's reference, data sets and accuracy page stand on the models (census, sgm, dense_stereo)
     "tools/dense": {"tools/core", "tools/models"},
-    "tools/cli": {"tools/core", "tools/models", "tools/rectify", "tools/matching"},
-    "tools/reports": {"tools/core", "tools/models", "tools/rectify", "tools/matching", "tools/cli"},
+    # the board's host side (issue 27): the bridge's protocol model and the register map's driver
+    "tools/board": {"tools/core", "tools/models"},
+    "tools/cli": {"tools/core", "tools/models", "tools/rectify", "tools/matching", "tools/board"},
+    "tools/reports": {"tools/core", "tools/models", "tools/rectify", "tools/matching", "tools/cli", "tools/board"},
     # hdl: every room may import tools; no block room imports system or flow
     "hdl/interfaces": TOOLS | {"hdl/common"},
     "hdl/common": TOOLS | {"hdl/interfaces"},
@@ -76,9 +79,14 @@ ROOMS = {
     "hdl/dense": TOOLS | {"hdl/common", "hdl/interfaces", "hdl/streaming"},
     # the hardware feature matcher (issue 29): the engine; its front half will take the census from dense
     "hdl/matching": TOOLS | {"hdl/common", "hdl/interfaces", "hdl/streaming", "hdl/dense"},
+    # the board's own blocks (issue 27): the monitor output and the host's serial link
+    "hdl/video": TOOLS | {"hdl/common", "hdl/interfaces"},
+    "hdl/serial": TOOLS | {"hdl/common", "hdl/interfaces"},
     "hdl/system": TOOLS | BLOCKS,
-    "hdl/flow": TOOLS | BLOCKS | {"hdl/system"},
-    "hdl": TOOLS | BLOCKS | {"hdl/system"},
+    # a board's top: the front end and the board's blocks around it
+    "hdl/boards": TOOLS | BLOCKS | {"hdl/system"},
+    "hdl/flow": TOOLS | BLOCKS | {"hdl/system", "hdl/boards"},
+    "hdl": TOOLS | BLOCKS | {"hdl/system", "hdl/boards"},
     # sim: every room may import tools and hdl; measure is the top (it measures and documents the apps),
     # so apps never import measure; a bench imports no other bench (test_bench_imports_no_other_bench)
     "sim": set(),
@@ -92,13 +100,14 @@ ROOMS = {
 #: The rooms from the bottom up: a room imports only rooms of lower tiers, except that the two rooms of
 #: :data:`BASE` import each other (the port bundles use the checks, the checks know the bundles).
 TIERS = [
-    {"tools/core"}, {"tools/rectify"}, {"tools/models"}, {"tools/matching", "tools/dense"}, {"tools/cli"},
-    {"tools/reports"},
+    {"tools/core"}, {"tools/rectify"}, {"tools/models"}, {"tools/matching", "tools/dense", "tools/board"},
+    {"tools/cli"}, {"tools/reports"},
     {"hdl/interfaces", "hdl/common"},
     {"hdl/streaming"},
-    {"hdl/harris", "hdl/rectify", "hdl/camera", "hdl/memory", "hdl/axi", "hdl/dense"},
+    {"hdl/harris", "hdl/rectify", "hdl/camera", "hdl/memory", "hdl/axi", "hdl/dense", "hdl/video", "hdl/serial"},
     {"hdl/matching"},
     {"hdl/system"},
+    {"hdl/boards"},
     {"hdl/flow", "hdl"},
     {"sim", "sim/lib"},
     {"sim/harnesses"},

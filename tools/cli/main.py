@@ -5,6 +5,7 @@
     eyestereo calibrate | maps | fit | warp | lut | rig | rectifier    the Rectification Toolbox  (cli.rectify)
     eyestereo ffc | package                                            float-to-fixed, VHDL package (cli.ffc)
     eyestereo evaluate | sweep                                         feature matching study      (cli.matching)
+    eyestereo board status | set | grab | adapt | program              the board design's host tool (cli.board)
     eyestereo <group from an "eyestereo.cli" entry point>              e.g. the simulation commands of eyestereo.sim
 
 This module only assembles the groups; the shared parser, argument types, one-line errors and exit
@@ -29,13 +30,13 @@ from collections.abc import Callable, Sequence
 from importlib import metadata
 from typing import Any
 
-from eyestereo.tools.cli import ffc, matching, rectify
+from eyestereo.tools.cli import board, ffc, matching, rectify
 from eyestereo.tools.cli.common import PROG, Parser, run_command
 
 __all__ = ["ENTRY_POINT_GROUP", "GROUPS", "build_parser", "main"]
 
 #: The toolbox's own groups, in the order of ``eyestereo --help``.
-GROUPS: tuple[Callable[[Any], None], ...] = (rectify.register, ffc.register, matching.register)
+GROUPS: tuple[Callable[[Any], None], ...] = (rectify.register, ffc.register, matching.register, board.register)
 #: Entry-point group through which other layers add subcommands.
 ENTRY_POINT_GROUP = "eyestereo.cli"
 

@@ -1,0 +1,1 @@
+"""Serial links: UART receiver and transmitter, the UART bridge to the AXI4-Lite register bus."""
