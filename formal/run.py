@@ -125,8 +125,8 @@ _FIFO_FRAME_MUTANTS = (
     ("no token after wrst (the abandoned frame's words left open)",
      "if (wrst) begin\n        if (mid) begin", "if (wrst) begin\n        if (1'b0) begin"),
     ("the dropped counter not incremented on an overflow", "inc = ((!bad) && (tok_pend || full_s));", "inc = 1'b0;"),
-    ("the counter's Gray-to-binary conversion without the running xor",
-     "b[i] = (b[(i + 1)] ^ cgray_s2[i]);", "b[i] = cgray_s2[i];"),
+    ("the counter's Gray-to-binary conversion without the running xor (each bit the last Gray bit alone)",
+     "x[0] = (x[0] ^ cgray_s2[j]);", "x[0] = cgray_s2[j];"),
     ("rrst inside a frame does not skip (skip cleared)", "skip <= (!q_eof);", "skip <= 1'b0;"),
 )
 #: the arbiter at the smallest parameters that elaborate (sram_arbiter, _wait, _fair, _turns)

@@ -81,20 +81,31 @@ def board_regs(clk, rst, bus, display_run, sccb_restart, pll_locked, sccb_busy, 
     wdat = Signal(bool(0))
     wstb = Signal(bool(0))
 
+    aw_r, w_r, ar_r, b_v, r_v = (Signal(bool(0)) for _ in range(5))
+
+    @always_comb
+    def handshake():
+        # the slave's readies and valids from registers of their own (VHDL-93 cannot read an output port)
+        bus.awready.next = aw_r
+        bus.wready.next = w_r
+        bus.arready.next = ar_r
+        bus.bvalid.next = b_v
+        bus.rvalid.next = r_v
+
     @always_seq(clk.posedge, reset=rst)
     def serve():
         sccb_restart.next = 0
-        if bus.bvalid and bus.bready:
-            bus.bvalid.next = 0
+        if b_v and bus.bready:
+            b_v.next = 0
             busy.next = 0
-        if bus.rvalid and bus.rready:
-            bus.rvalid.next = 0
+        if r_v and bus.rready:
+            r_v.next = 0
             busy.next = 0
-        if bus.awready:
+        if aw_r:
             # the write's address and data move at this edge: act, answer from the next clock
-            bus.awready.next = 0
-            bus.wready.next = 0
-            bus.bvalid.next = 1
+            aw_r.next = 0
+            w_r.next = 0
+            b_v.next = 1
             bus.bresp.next = SLVERR
             if wword == a_ctrl:
                 bus.bresp.next = OKAY
@@ -104,9 +115,9 @@ def board_regs(clk, rst, bus, display_run, sccb_restart, pll_locked, sccb_busy, 
                 bus.bresp.next = OKAY
                 if wstb and wdat:
                     sccb_restart.next = 1
-        elif bus.arready:
-            bus.arready.next = 0
-            bus.rvalid.next = 1
+        elif ar_r:
+            ar_r.next = 0
+            r_v.next = 1
             bus.rresp.next = OKAY
             bus.rdata.next = 0
             if rword == a_id:
@@ -125,15 +136,15 @@ def board_regs(clk, rst, bus, display_run, sccb_restart, pll_locked, sccb_busy, 
                 bus.rresp.next = SLVERR
         elif not busy:
             if bus.awvalid and bus.wvalid:
-                bus.awready.next = 1
-                bus.wready.next = 1
+                aw_r.next = 1
+                w_r.next = 1
                 busy.next = 1
                 wword.next = bus.awaddr[BOARD_REGMAP.addr_bits:2]
                 wdat.next = bus.wdata[0]
                 wstb.next = bus.wstrb[0]
             elif bus.arvalid:
-                bus.arready.next = 1
+                ar_r.next = 1
                 busy.next = 1
                 rword.next = bus.araddr[BOARD_REGMAP.addr_bits:2]
 
-    return status_word, outs, serve
+    return status_word, outs, handshake, serve

@@ -8,6 +8,7 @@ from eyestereo.hdl.axi.axil_arbiter import axil_arbiter
 from eyestereo.hdl.axi.axil_split import axil_split
 from eyestereo.hdl.boards.board_regs import board_regs
 from eyestereo.hdl.boards.ecp5 import ecp5_pll, oddr, tristate
+from eyestereo.hdl.boards.sdram_pins import sdram_pins
 from eyestereo.hdl.camera.sccb_master import sccb_master
 from eyestereo.hdl.common.checks import block_error, check_choice, check_int
 from eyestereo.hdl.interfaces.axil import AxiLite
@@ -161,17 +162,6 @@ def ulx3s(clk_25mhz, led, btn, ftdi_txd, ftdi_rxd, sdram_clk, sdram_cke, sdram_c
                                  rectify="stream", order=order,
                                  matcher=matcher, feature_words=amap.feature_words))
 
-    @always_comb
-    def sdram_pins():
-        sdram_cke.next = sdram.cke
-        sdram_csn.next = sdram.cs_n
-        sdram_wen.next = sdram.we_n
-        sdram_rasn.next = sdram.ras_n
-        sdram_casn.next = sdram.cas_n
-        sdram_a.next = sdram.a
-        sdram_ba.next = sdram.ba
-        sdram_dqm.next = sdram.dqm
-
     # the constants the primitives' instances take, each from a flip-flop of its own clock (a signal that only
     # user-defined code reads is not declared in MyHDL's HDL: it must be driven by a process)
     one, zero = Signal(bool(1)), Signal(bool(0))
@@ -183,8 +173,8 @@ def ulx3s(clk_25mhz, led, btn, ftdi_txd, ftdi_rxd, sdram_clk, sdram_cke, sdram_c
 
     insts.append(constants)
     ck0, ck1 = (zero, one) if sdram_clock == "inverted" else (one, zero)
-    insts += [sdram_pins, tristate(sdram.dq_o, sdram.dq_oe, sdram.dq_i, sdram_d, label="sdram_dq"),
-              oddr(mclk, ck0, ck1, sdram_clk, label="sdram_clk_oddr")]
+    insts += [sdram_pins(sdram, sdram_cke, sdram_csn, sdram_wen, sdram_rasn, sdram_casn, sdram_a, sdram_ba, sdram_dqm,
+                         sdram_d), oddr(mclk, ck0, ck1, sdram_clk, label="sdram_clk_oddr")]
 
     # ---- the host's bus: bridge -> split -> (arbiter with the display -> front end | board registers) -------
     br_bus = AxiLite(24)

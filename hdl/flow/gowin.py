@@ -59,7 +59,7 @@ from pathlib import Path
 
 from myhdl import ResetSignal, Signal, TristateSignal, always, always_comb, always_seq, block, intbv
 
-from eyestereo.hdl.boards.ecp5 import tristate
+from eyestereo.hdl.boards.sdram_pins import sdram_pins
 from eyestereo.hdl.boards.ulx3s import CLOCKS, rs_sync
 from eyestereo.hdl.common.checks import block_error, check_int, check_signal
 from eyestereo.hdl.flow.bitstream import MARGIN, PCLK_MHZ, drop_zero_memory_init, port_bits
@@ -184,17 +184,6 @@ def gowin_frontend(mem_clk, harris_clk, rst_btn, uart_rx, uart_tx, led, sdram_cl
                                  quantizers=quantizers, memory="sdram", sdram_part=sdram_part,
                                  memory_mhz=GOALS["mem_clk"], rectify="stream", order=order))
 
-    @always_comb
-    def sdram_pins():
-        sdram_cke.next = sdram.cke
-        sdram_csn.next = sdram.cs_n
-        sdram_wen.next = sdram.we_n
-        sdram_rasn.next = sdram.ras_n
-        sdram_casn.next = sdram.cas_n
-        sdram_a.next = sdram.a
-        sdram_ba.next = sdram.ba
-        sdram_dqm.next = sdram.dqm
-
     # the ODDR's constant inputs, each from a flip-flop (a signal only user code reads is not declared by MyHDL)
     one, zero = Signal(bool(1)), Signal(bool(0))
 
@@ -203,7 +192,8 @@ def gowin_frontend(mem_clk, harris_clk, rst_btn, uart_rx, uart_tx, led, sdram_cl
         one.next = 1
         zero.next = 0
 
-    insts += [sdram_pins, constants, tristate(sdram.dq_o, sdram.dq_oe, sdram.dq_i, sdram_d, label="sdram_dq"),
+    insts += [constants, sdram_pins(sdram, sdram_cke, sdram_csn, sdram_wen, sdram_rasn, sdram_casn, sdram_a, sdram_ba,
+                                    sdram_dqm, sdram_d),
               gowin_oddr(mem_clk, one, zero, sdram_clk, label="sdram_clk_oddr")]
 
     # ---- the host's bus: the UART bridge straight onto the front end's register bank --------------------------

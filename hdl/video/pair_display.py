@@ -120,10 +120,10 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
     The front end keeps its rectified pairs and feature lists in the frame store, where the host takes them with
     the buffer handshake (CTRL.rect_want/feat_want, STATUS.rect_held/feat_held, CMD.rect_release/feat_release;
     docs/registers.md). This block is such a host, on the bus beside the board's UART bridge (an AXI4-Lite
-    arbiter between them): once per monitor frame it takes the newest pair and lists, reads the pair's
-    ``width x height`` words through the SRAM window into two block RAMs (left, right; 8 bits a pixel, codes
-    255 clipped to 254), then each listed corner's cross of :data:`~eyestereo.tools.models.pair_display.CROSS`
-    pixels is written as the mark code 255 into its camera's RAM, and the buffers are given back. In the pixel
+    arbiter between them): once per monitor frame it takes the newest pair and lists, reads the list (each corner's
+    cross of :data:`~eyestereo.tools.models.pair_display.CROSS` pixels into its camera's mark plane), then the pair's
+    ``width x height`` words through the SRAM window into two block RAMs (left, right; 8 bits a pixel, codes 255
+    clipped to 254, a marked pixel written as the mark code 255), and gives the buffers back. In the pixel
     clock a :func:`~eyestereo.hdl.video.video_timing.video_timing` scans the mode; the top ``height`` lines show
     the left image at x < ``width`` and the right one beside it; the next ``height`` lines an anaglyph of the two
     (red the left, green and blue the right: rows that line up are grey); everything else is black. The colour
@@ -133,8 +133,9 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
     Tearing: one copy of the pair, written while it is shown. The copy starts when the scan enters the anaglyph
     half (line ``height``), so that the scan of the next frame's top half starts behind the copy; a copy that
     takes less than the time from there to the end of the next frame's top half (about 26 ms at 640x480@60
-    with 320x240 images) is never overtaken, and each frame shows one pair (measured in the board simulation:
-    docs/boards.md). The marks of a pair appear with its pixels' copy done, within the same frame's bottom half.
+    with 320x240 images) is never overtaken (an estimate from the mode's timing, not a measurement). The copy
+    reads the list first and draws each corner's cross into a 1-bit mark plane per camera, then writes every pixel
+    with its mark in one write (code 255 where the plane says so): a pixel and its mark change together.
 
     Ports:
         clk, rst: the bus clock (the memory clock) and its synchronous reset.
@@ -165,8 +166,9 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
     ``de`` are delayed with it. A copy takes about ``width x height`` reads of the SRAM window (each a bank read
     plus the memory's wait) and 9 writes per listed corner.
 
-    Resources: two ``width x height x 8`` block RAMs (320x240: 38 DP16KD each on the ECP5), the FSM, a
-    constant multiplier for the scan address.
+    Resources: two ``width x height x 8`` block RAMs (320x240: 38 DP16KD each on the ECP5), two ``width x
+    height`` x 1 mark planes in banks of 16,384 (5 DP16KD each), the FSM, constant multipliers for the scan and the
+    crosses' addresses (the whole board's figures: docs/boards.md).
     """
     check_clock(clk)
     check_reset(rst)
@@ -233,6 +235,7 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
     st = enum("S_BOOT", "S_START", "S_IDLE", "S_WR", "S_WR_B", "S_POLL", "S_POLL_R", "S_GAP", "S_PIX", "S_PIX_R",
               "S_FEAT", "S_FEAT_R", "S_MARK", "S_UNWANT")
     state = Signal(st.S_BOOT if autostart else st.S_IDLE)
+    awv, wv, rr = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
     resume = Signal(st.S_IDLE)  # where a register write goes when its response came
     tog = Signal(bool(0))  # pixel clock: toggles when the scan enters line `height`
     start = Signal(bool(0))
@@ -273,22 +276,22 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
         if mwait != 0:
             mwait.next = mwait - 1
             if mwait == 1:
-                bus.rready.next = 1
+                rr.next = 1
         if state == st.S_BOOT:
             # start the front end: overlapped and continuous (CTRL byte 0), then CMD.start
             bus.awaddr.next = a_ctrl
             bus.wdata.next = run_word
             bus.wstrb.next = 1
-            bus.awvalid.next = 1
-            bus.wvalid.next = 1
+            awv.next = 1
+            wv.next = 1
             resume.next = st.S_START
             state.next = st.S_WR
         elif state == st.S_START:
             bus.awaddr.next = a_cmd
             bus.wdata.next = start_word
             bus.wstrb.next = 1
-            bus.awvalid.next = 1
-            bus.wvalid.next = 1
+            awv.next = 1
+            wv.next = 1
             resume.next = st.S_IDLE
             state.next = st.S_WR
         elif state == st.S_IDLE:
@@ -298,17 +301,17 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
                 bus.awaddr.next = a_ctrl
                 bus.wdata.next = want_word
                 bus.wstrb.next = want_strb
-                bus.awvalid.next = 1
-                bus.wvalid.next = 1
+                awv.next = 1
+                wv.next = 1
                 resume.next = st.S_POLL
                 state.next = st.S_WR
         elif state == st.S_WR:
             # one register write: address and data offered together, each dropped when taken
             if bus.awready:
-                bus.awvalid.next = 0
+                awv.next = 0
             if bus.wready:
-                bus.wvalid.next = 0
-            if (bus.awready or not bus.awvalid) and (bus.wready or not bus.wvalid):
+                wv.next = 0
+            if (bus.awready or not awv) and (bus.wready or not wv):
                 bus.bready.next = 1
                 state.next = st.S_WR_B
         elif state == st.S_WR_B:
@@ -320,15 +323,15 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
                 if resume == st.S_POLL:
                     bus.araddr.next = a_status
                     bus.arvalid.next = 1
-                    bus.rready.next = 1
+                    rr.next = 1
                 state.next = resume
         elif state == st.S_UNWANT:
             # the wants withdrawn (after a release, or when no pair came)
             bus.awaddr.next = a_ctrl
             bus.wdata.next = 0
             bus.wstrb.next = want_strb
-            bus.awvalid.next = 1
-            bus.wvalid.next = 1
+            awv.next = 1
+            wv.next = 1
             resume.next = st.S_IDLE
             state.next = st.S_WR
         elif state == st.S_POLL:
@@ -337,7 +340,7 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
                 state.next = st.S_POLL_R
         elif state == st.S_POLL_R:
             if bus.rvalid:
-                bus.rready.next = 0
+                rr.next = 0
                 if bus.rdata[rect_held] and bus.rdata[feat_held]:
                     # the corners first (into the mark planes), then the pixels
                     if bus.rdata[rect_buf]:
@@ -355,7 +358,7 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
                     nfeat.next = 0
                     state.next = st.S_FEAT
                     bus.arvalid.next = 1
-                    bus.rready.next = 1
+                    rr.next = 1
                 elif tries == polls - 1 or not run:
                     state.next = st.S_UNWANT  # give up for this frame
                 else:
@@ -366,7 +369,7 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
             if gap == 0:
                 bus.araddr.next = a_status
                 bus.arvalid.next = 1
-                bus.rready.next = 1
+                rr.next = 1
                 state.next = st.S_POLL
             else:
                 gap.next = gap - 1
@@ -375,7 +378,7 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
                 bus.arvalid.next = 0
                 state.next = st.S_PIX_R
         elif state == st.S_PIX_R:
-            if bus.rvalid and bus.rready:
+            if bus.rvalid and rr:
                 # a pixel and its mark in one write: the picture never shows a pixel without the mark it has
                 w_addr.next = idx
                 if mark_l:
@@ -394,12 +397,12 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
                 we_r.next = 1
                 if idx == npix - 1:
                     # the pair is copied: both buffers given back
-                    bus.rready.next = 0
+                    rr.next = 0
                     bus.awaddr.next = a_cmd
                     bus.wdata.next = release_word
                     bus.wstrb.next = want_strb
-                    bus.awvalid.next = 1
-                    bus.wvalid.next = 1
+                    awv.next = 1
+                    wv.next = 1
                     copied.next = 1
                     resume.next = st.S_UNWANT
                     state.next = st.S_WR
@@ -407,7 +410,7 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
                     idx.next = idx + 1
                     bus.araddr.next = SRAM_BASE + 4 * (rbase + idx + 1)
                     bus.arvalid.next = 1
-                    bus.rready.next = 0
+                    rr.next = 0
                     mwait.next = PLANE_LATENCY
                     state.next = st.S_PIX
         elif state == st.S_FEAT:
@@ -422,7 +425,7 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
                         idx.next = 0
                         bus.araddr.next = SRAM_BASE + 4 * rbase
                         bus.arvalid.next = 1
-                        bus.rready.next = 0
+                        rr.next = 0
                         mwait.next = MARK_DRAIN + PLANE_LATENCY
                     else:
                         fx.next = bus.rdata[15:0]
@@ -433,7 +436,7 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
                         bus.arvalid.next = 1
                         state.next = st.S_FEAT
                 else:
-                    bus.rready.next = 0
+                    rr.next = 0
                     fy.next = bus.rdata[16:0]
                     half.next = 0
                     k.next = 0
@@ -444,11 +447,11 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
             if k == n_cross + MARK_DRAIN:
                 nfeat.next = nfeat + 1
                 bus.arvalid.next = 1
-                bus.rready.next = 1
+                rr.next = 1
                 if nfeat == max_features - 1:
                     idx.next = 0
                     bus.araddr.next = SRAM_BASE + 4 * rbase
-                    bus.rready.next = 0
+                    rr.next = 0
                     mwait.next = PLANE_LATENCY
                     state.next = st.S_PIX
                 else:
@@ -459,7 +462,7 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
                 k.next = k + 1
 
     @always_comb
-    def cross():
+    def cross_rom():
         dxk.next = cdx[k]
         dyk.next = cdy[k]
 
@@ -470,6 +473,10 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
 
     @always_comb
     def outs():
+        # the bus's valids and ready from registers of their own (VHDL-93 cannot read an output port)
+        bus.awvalid.next = awv
+        bus.wvalid.next = wv
+        bus.rready.next = rr
         copies.next = cnt
         idle.next = state == st.S_IDLE
 
@@ -535,7 +542,15 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
     pl, pr = Signal(intbv(0)[8:]), Signal(intbv(0)[8:])
     raddr = Signal(intbv(0)[pbits:])
     zone0 = Signal(intbv(0)[2:])
+    arow = Signal(intbv(0, min=0, max=m.v_active))
     line_seen = Signal(bool(0))
+
+    @always_comb
+    def anaglyph_row():
+        # the anaglyph's image row, unsigned on its own (in one expression with vx, Verilog would mix signedness)
+        arow.next = 0
+        if vy >= height:
+            arow.next = vy - height
 
     @always_comb
     def scan_addr():
@@ -551,7 +566,7 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
                     raddr.next = vy * width + vx - width
             elif vy < 2 * height and vx < width:
                 zone0.next = 3
-                raddr.next = (vy - height) * width + vx
+                raddr.next = arow * width + vx
 
     @always(pclk.posedge)
     def read():
@@ -603,5 +618,5 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
                 green.next = pr
                 blue.next = pr
 
-    return (sync, copy, cross, cross_pos, outs, write, plane_read, mark_pipe, plane_port, planes, timing,
-            scan_addr, read, stage1, stage2)
+    return (sync, copy, cross_rom, cross_pos, outs, write, plane_read, mark_pipe, plane_port, planes, timing,
+            anaglyph_row, scan_addr, read, stage1, stage2)
