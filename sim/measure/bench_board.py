@@ -28,11 +28,21 @@ CONFIG = dict(frames=400, target=12, k=10, monitor_frames=2, cam_mhz=12.5,
 MARKERS = ("<!-- boardsim:begin -->", "<!-- boardsim:end -->")
 
 
+def revision() -> str:
+    """The commit the measured HDL belongs to (``+`` when the tree differs from it)."""
+    import subprocess
+
+    root = Path(__file__).resolve().parents[2]
+    run = lambda *a: subprocess.run(["git", *a], cwd=root, capture_output=True, text=True)  # noqa: E731
+    rev = run("rev-parse", "--short", "HEAD").stdout.strip() or "unknown"
+    return rev + ("+" if run("status", "--porcelain", "hdl").stdout.strip() else "")
+
+
 def section(rep: dict, sim: str, wall: float) -> str:
     sim_ms = rep["sim_time_ns"] / 1e6
     clocks = rep["sim_time_ns"] * CLOCKS["mem"] / 1e3
     return "\n".join([
-        f"Measured by `python -m eyestereo.sim.measure.bench_board` ({sim}; the board top of this commit, the small "
+        f"Measured by `python -m eyestereo.sim.measure.bench_board` ({sim}; the board top of commit {revision()}, the small "
         "configuration above):", "",
         "| figure | value |", "|---|---:|",
         f"| features the host read over the serial line (= the model's) | {rep['features']} |",
