@@ -233,7 +233,7 @@ class HostDriver:
         # a bus with bursts (the board's serial link): one request per 256 words instead of one per word
         out = []
         for k, (data, resp) in enumerate(await self.bus.read_burst(r.address(words[0]), count)):
-            if resp != 0:
+            if resp != OKAY:
                 raise BusError(f"{r.label(words[k])}: read response {resp} (not OKAY)")
             out.append(int(data))
         return out
@@ -285,7 +285,7 @@ class HostDriver:
                 await self.write("SRAM", v, i)
             return
         for k, resp in enumerate(await self.bus.write_burst(r.address(words[0][0]), [v for _, v in words])):
-            if resp != 0:
+            if resp != OKAY:
                 raise BusError(f"{r.label(words[k][0])}: write response {resp} (not OKAY)")
 
 

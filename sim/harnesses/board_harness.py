@@ -48,14 +48,17 @@ _OUTS = ("CLKOP", "CLKOS", "CLKOS2", "CLKOS3")
 _PLL_INS = ("CLKI", "CLKFB", "RST", "STDBY", "PHASESEL0", "PHASESEL1", "PHASEDIR", "PHASESTEP", "PHASELOADREG",
             "PLLWAKESYNC", "ENCLKOP")
 
-def _vhdl_generics() -> str:
-    lines = [f'    {g}: string := "";' for g in _PLL_STRINGS]
-    lines += ["    CLKI_DIV: integer := 1;", "    CLKFB_DIV: integer := 1;"]
+def _pll_params() -> list[tuple[str, str, str]]:
+    """EHXPLLL's parameters the models declare: (name, VHDL type, default), in the instance's order."""
+    out = [(g, "string", '""') for g in _PLL_STRINGS] + [("CLKI_DIV", "integer", "1"), ("CLKFB_DIV", "integer", "1")]
     for o in _OUTS:
-        lines += [f'    {o}_ENABLE: string := "DISABLED";', f"    {o}_DIV: integer := 1;",
-                  f"    {o}_CPHASE: integer := 0;", f"    {o}_FPHASE: integer := 0;"]
-    lines[-1] = lines[-1].rstrip(";")
-    return "\n".join(lines) + "\n"
+        out += [(f"{o}_ENABLE", "string", '"DISABLED"'), (f"{o}_DIV", "integer", "1"),
+                (f"{o}_CPHASE", "integer", "0"), (f"{o}_FPHASE", "integer", "0")]
+    return out
+
+
+def _vhdl_generics() -> str:
+    return ";\n".join(f"    {n}: {t} := {d}" for n, t, d in _pll_params()) + "\n"
 
 
 def _vhdl_output(o: str) -> str:
@@ -77,13 +80,7 @@ def _vhdl_output(o: str) -> str:
 
 
 def _verilog_params() -> str:
-    lines = [f'  parameter {g} = "",' for g in _PLL_STRINGS]
-    lines += ["  parameter CLKI_DIV = 1,", "  parameter CLKFB_DIV = 1,"]
-    for o in _OUTS:
-        lines += [f'  parameter {o}_ENABLE = "DISABLED",', f"  parameter {o}_DIV = 1,",
-                  f"  parameter {o}_CPHASE = 0,", f"  parameter {o}_FPHASE = 0,"]
-    lines[-1] = lines[-1].rstrip(",")
-    return "\n".join(lines) + "\n"
+    return ",\n".join(f"  parameter {n} = {d}" for n, _, d in _pll_params()) + "\n"
 
 
 def _verilog_output(o: str) -> str:

@@ -90,3 +90,12 @@ def test_picture_is_the_models(request, cfg):
 def test_no_pair_gives_the_wants_back(request):
     rep = run_bench("pair_display", "tb_pair_display", dict(absent=True), name=request.node.name, params=SMALL)
     assert rep["copies"] == 0
+
+
+@pytest.mark.othersims
+@pytest.mark.parametrize("sim", ["icarus", "verilator"])
+def test_picture_on_the_verilog_simulators(request, sim):
+    """MyHDL's Verilog of the block on Icarus and Verilator: the same picture as the model's, bit for bit."""
+    rep = run_bench("pair_display", "tb_pair_display", dict(rect_buf=1, feat_buf=0, seed=3, features=14, frames=2),
+                    name=request.node.name, params={**SMALL, "autostart": True}, sim=sim)
+    assert rep["frames_checked"] == 2 and rep["latency"] == 3
