@@ -153,10 +153,12 @@ synth: setup
 # A board's bitstream (issue 27; docs/boards.md): the board top (MyHDL's Verilog) -> Yosys synth_ecp5 -> nextpnr-ecp5
 # with the board's pins and every clock constrained 10 % above its frequency -> ecppack: build/board/<BOARD>/<BOARD>.bit.
 # SEEDS: the nextpnr seeds tried (the first that meets every clock is packed; docs/boards.md gives seeds 1-4).
+# MATCHER=1: with the front end's hardware matcher (the monitor draws the matches).
 BOARD ?= ulx3s-85f
 SEEDS ?= 1
+MATCHER ?=
 bitstream: setup
-	$(PY) -m eyestereo.hdl.flow.bitstream --board $(BOARD) --seeds $(SEEDS)
+	$(PY) -m eyestereo.hdl.flow.bitstream --board $(BOARD) --seeds $(SEEDS) $(if $(filter 1 yes true,$(MATCHER)),--matcher)
 
 # The front end placed for a Gowin GW2A-18 (the Tang Primer 20K's part) with yosys and nextpnr-himbaechel: a placement
 # study for portability (docs/boards.md; about half an hour on 2 cores for seeds 1-4; not in make test).

@@ -350,7 +350,8 @@ REGISTERS: tuple[Register, ...] = (
                  connect="feature_list total_left (stereo_frontend runs feature_list in the memory clock)"),
               _f("features_right", 16, 16, "right camera",
                  connect="feature_list total_right"))),
-    Register("DROPPED", 0x028, "status", "camera frames dropped (camera_interface's counters)",
+    Register("DROPPED", 0x028, "status", "camera frames dropped (camera_interface's counters; rectify=stream: "
+             "plus each frame the rectifier found overwritten, once)",
              (_f("dropped_left", 0, 16, "left camera", connect="camera_pair dropped_l (already in the memory clock)"),
               _f("dropped_right", 16, 16, "right camera", connect="camera_pair dropped_r"))),
     Register("OVERFLOWS", 0x02C, "status", "frames lost to overflows after the cameras",

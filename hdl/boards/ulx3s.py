@@ -69,7 +69,7 @@ def ulx3s(clk_25mhz, led, btn, ftdi_txd, ftdi_rxd, sdram_clk, sdram_cke, sdram_c
           cam_l_resetn, cam_l_pwdn, cam_r, cam_r_xclk, cam_r_sioc, cam_r_siod, cam_r_resetn, cam_r_pwdn, *,
           quantizers="rig:320x240", mode: str = "640x480@60", clocks_per_bit: int = 25,
           sccb_table=OV7670_TABLE, sccb_hz: float = 100e3, sdram_clock: str = "same", order: str = "YUYV",
-          matcher: bool = False, reset_hold: int = 3):
+          matcher: bool = False, match_rows: int = 1, reset_hold: int = 3):
     """The board top: the stereo front end with ``memory="sdram"`` and ``rectify="stream"`` on the ULX3S, the cameras
     configured over SCCB at start, the newest rectified pair and its corners on the HDMI monitor, the register map
     on the USB serial port (docs/boards.md: wiring, building, programming, the host tool).
@@ -109,8 +109,11 @@ def ulx3s(clk_25mhz, led, btn, ftdi_txd, ftdi_rxd, sdram_clk, sdram_cke, sdram_c
         sccb_hz: the SCCB clock (at most 400 kHz).
         sdram_clock: :data:`SDRAM_CLOCK`.
         order: the cameras' byte order (the table's COM13/TSLB settings give YUYV).
-        matcher: the front end's hardware matcher (the match list follows the features; the monitor marks the
-            corners alone).
+        matcher: the front end's hardware matcher (the match list follows the features; the monitor draws each
+            match as a segment in the anaglyph, from the right corner's column to the left's:
+            :func:`~eyestereo.hdl.video.pair_display.pair_display`).
+        match_rows: with ``matcher``, the rows searched above and below a left corner's (0..7; default 1: a rig's
+            rectification seldom lines its rows up to the pixel; the front end's own default is 0).
         reset_hold: flip-flops of each reset synchroniser (2..8).
 
     Latency: the picture shows a pair about a monitor frame after the front end finished it (the copy starts
@@ -160,7 +163,7 @@ def ulx3s(clk_25mhz, led, btn, ftdi_txd, ftdi_rxd, sdram_clk, sdram_cke, sdram_c
     insts.append(stereo_frontend(mclk, rst_m, hclk, rst_h, cam_l, wrst_l, cam_r, wrst_r, fe_bus, sdram,
                                  quantizers=cal, memory="sdram", sdram_part=ULX3S, memory_mhz=CLOCKS["mem"],
                                  rectify="stream", order=order,
-                                 matcher=matcher, feature_words=amap.feature_words))
+                                 matcher=matcher, match_rows=match_rows, feature_words=amap.feature_words))
 
     # the constants the primitives' instances take, each from a flip-flop of its own clock (a signal that only
     # user-defined code reads is not declared in MyHDL's HDL: it must be driven by a process)
@@ -216,7 +219,8 @@ def ulx3s(clk_25mhz, led, btn, ftdi_txd, ftdi_rxd, sdram_clk, sdram_cke, sdram_c
                               blue,
                               width=width, height=height, rect_base=(amap.rectified(0), amap.rectified(1)),
                               feat_base=(amap.features(0), amap.features(1)),
-                              max_features=min(1023, MAX_FEATURES), mode=vmode.name, autostart=True))
+                              max_features=min(1023, MAX_FEATURES), mode=vmode.name, autostart=True, matches=matcher,
+                              max_matches=1023))
     q_b, q_g, q_r = (Signal(intbv(0)[10:]) for _ in range(3))
     insts += [tmds_encoder(pclk, rst_p, blue, hs, vs, de, q_b), tmds_encoder(pclk, rst_p, green, zero, zero, de, q_g),
               tmds_encoder(pclk, rst_p, red, zero, zero, de, q_r)]

@@ -4,7 +4,8 @@
 Steps, in ``<out>/`` (default ``build/board/<board>``):
 
 1. MyHDL's Verilog of the board top (``ulx3s.v``; the ECP5 primitives are instances in it) and its VHDL beside it
-   (``vhdl/``, analysed by GHDL: the VHDL stays the product, the board simulation runs it too).
+   (``vhdl/``: the VHDL stays the product; the board simulation runs the top's VHDL on GHDL), converted in a
+   child Python with a fixed string-hash seed (:data:`HASH_SEED`): the same commit gives the same netlist.
 2. The LPF: the ports' pins and I/O settings from the board's constraint file (:mod:`eyestereo.tools.board.ulx3s`)
    and one clock constraint, the oscillator's, raised by :data:`MARGIN` (10 %): nextpnr derives every PLL output's
    constraint from it, so each clock is placed and routed for its frequency plus the margin; the cameras' PCLK
@@ -24,6 +25,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import pickle
 import re
 import shutil
 import subprocess
@@ -42,7 +45,7 @@ from eyestereo.hdl.interfaces.camera_bus import CameraBus
 from eyestereo.tools.board import ulx3s as board_pins
 from eyestereo.tools.io import write_section
 
-__all__ = ["BOARDS", "MARGIN", "board_ports", "build", "main"]
+__all__ = ["BOARDS", "HASH_SEED", "MARGIN", "board_ports", "build", "convert_reproducibly", "main"]
 
 #: The boards ``make bitstream BOARD=...`` knows: name -> (top function, its pin module).
 BOARDS = {board_pins.BOARD: (ulx3s, board_pins)}
@@ -68,6 +71,40 @@ def board_ports() -> dict:
                 cam_l_resetn=cl["resetn"], cam_l_pwdn=cl["pwdn"],
                 cam_r=cr["bus"], cam_r_xclk=cr["xclk"], cam_r_sioc=cr["sioc"], cam_r_siod=cr["siod"],
                 cam_r_resetn=cr["resetn"], cam_r_pwdn=cr["pwdn"])
+
+
+#: The hash seed of the conversion's Python: MyHDL orders some of its output (sensitivity lists, a block's
+#: processes) by sets of names, so with Python's random string hashes each run wrote another, equivalent, Verilog,
+#: which Yosys and nextpnr place differently (a clock's fmax moved by several MHz between runs of one commit). The
+#: flow converts in a child Python with this seed: one commit, one netlist, one bitstream per nextpnr seed.
+HASH_SEED = "0"
+
+_CHILD = ("import pickle, sys\n"
+          "from pathlib import Path\n"
+          "from eyestereo.hdl.flow.bitstream import convert_top\n"
+          "a = pickle.load(sys.stdin.buffer)\n"
+          "try:\n"
+          "    for hdl, where in a['runs']:\n"
+          "        convert_top(Path(where), hdl=hdl, **a['params'])\n"
+          "except ValueError as e:\n"
+          "    print('ValueError: ' + str(e).splitlines()[0], file=sys.stderr)\n"
+          "    sys.exit(3)\n")
+
+
+def convert_reproducibly(out: Path, *, vhdl: bool = True, **params) -> Path:
+    """The board top's Verilog (``out/ulx3s.v``) and, with ``vhdl``, VHDL (``out/vhdl/``), converted in a child
+    Python whose string hashes are :data:`HASH_SEED`'s; returns the Verilog file. A parameter the top refuses is
+    the child's ValueError, raised here."""
+    env = dict(os.environ, PYTHONHASHSEED=HASH_SEED)
+    runs = [("Verilog", str(out))] + ([("VHDL", str(out / "vhdl"))] if vhdl else [])
+    arg = pickle.dumps(dict(params=params, runs=runs))
+    r = subprocess.run([sys.executable, "-c", _CHILD], input=arg, capture_output=True, env=env)
+    if r.returncode != 0:
+        last = (r.stderr.decode(errors="replace").strip().splitlines() or ["(no message)"])[-1]
+        if r.returncode == 3 and last.startswith("ValueError: "):
+            raise ValueError(last[len("ValueError: "):])
+        raise RuntimeError(f"the conversion of the board top failed: {last}")
+    return out / "ulx3s.v"
 
 
 def convert_top(out: Path, *, hdl: str = "Verilog", **params) -> Path:
@@ -118,10 +155,9 @@ def build(board: str, out: Path, *, seeds=(1,), mapping=None, **params) -> dict:
         shutil.rmtree(out)
     out.mkdir(parents=True)
     t0 = time.perf_counter()
-    v = convert_top(out, **params)
+    v = convert_reproducibly(out, **params)
     text, dropped = drop_zero_memory_init(v.read_text())
     v.write_text(text)
-    convert_top(out / "vhdl", hdl="VHDL", **params)
     t_conv = time.perf_counter() - t0
     yosys(f"read_verilog {v.name}; synth_ecp5 -top ulx3s -json ulx3s.json", out, "yosys.log")
     dsp = pack_file(out / "ulx3s.json", "ulx3s")
@@ -220,6 +256,9 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, help="output folder (default build/board/<board>)")
     ap.add_argument("--seeds", default="1", help="nextpnr seeds to try in turn, e.g. 1,2,3,4 (default 1)")
     ap.add_argument("--cameras", type=Path, help="the cameras' header mapping, a JSON file (docs/boards.md)")
+    ap.add_argument("--matcher", action="store_true",
+                    help="with the front end's hardware matcher (the monitor draws the matches; eyestereo board grab "
+                         "--matches reads them)")
     ap.add_argument("--doc", type=Path, help="fill this page's bitstream section with the figures (docs/boards.md)")
     ap.add_argument("--from-summary", type=Path, metavar="JSON",
                     help="no build: fill --doc from a kept run's bitstream.json (<out>/bitstream.json)")
@@ -250,7 +289,7 @@ def main(argv=None) -> int:
         write_section(args.doc, text, *DOC_MARKERS)
         return 0
     try:
-        s = build(args.board, out, seeds=seeds, mapping=args.cameras)
+        s = build(args.board, out, seeds=seeds, mapping=args.cameras, **({"matcher": True} if args.matcher else {}))
     except (ValueError, RuntimeError) as e:
         print(f"error: {str(e).splitlines()[0]}", file=sys.stderr)
         summary = out / "bitstream.json"

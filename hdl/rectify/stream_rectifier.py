@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from myhdl import Signal, always_comb, block
+from myhdl import Signal, always_comb, always_seq, block
 
 from eyestereo.hdl.common.checks import block_error, check_clock, check_int, check_reset, check_signal, check_stream
 from eyestereo.hdl.interfaces.fetch_port import FetchPort
@@ -55,8 +55,10 @@ def stream_rectifier(clk, rst, cam0, cam1, source, start, arm, begun, busy, over
         begun: out, 1 bit: both cameras have begun a frame since the last start or arm, while the rectifier was
             idle (a register).
         busy: out, 1 bit: a frame is being rectified (from the start to its last beat).
-        overrun: out, 1 bit: one-clock pulse: the frame being rectified read a line the cameras had already
-            overwritten, or a camera began its next frame first: the frame is not the cameras' (drop it).
+        overrun: out, 1 bit: one-clock pulse, at most one per frame (a register): the frame being rectified read
+            a line the cameras had already overwritten, or a camera began its next frame first: the frame is not
+            the cameras' (drop it). The line cache pulses at every such read; this port counts the frame once, so
+            a counter of its pulses counts frames (the front end's DROPPED registers).
         coef: optional :class:`~eyestereo.hdl.rectify.poly_unit.CoefPort`, as for the rectifier.
         hold: optional in, 1 bit: while high the rectifier makes no new fetch
             (:func:`~eyestereo.hdl.rectify.fetch_gate.fetch_gate`; the front end's dense option paces it so). A held
@@ -98,7 +100,8 @@ def stream_rectifier(clk, rst, cam0, cam1, source, start, arm, begun, busy, over
 
     fetch = FetchPort(cal.source_width, cal.source_height)
     go, r_busy, c_begun = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
-    cache = line_cache(clk, rst, cam0, cam1, fetch, go, r_busy, arm, c_begun, overrun, width=cal.source_width,
+    c_overrun, told = Signal(bool(0)), Signal(bool(0))
+    cache = line_cache(clk, rst, cam0, cam1, fetch, go, r_busy, arm, c_begun, c_overrun, width=cal.source_width,
                        height=cal.source_height, lines=lines)
     rfetch = fetch
     gate = []
@@ -115,4 +118,13 @@ def stream_rectifier(clk, rst, cam0, cam1, source, start, arm, begun, busy, over
         busy.next = r_busy
         begun.next = c_begun  # an output port is not read (VHDL-93)
 
-    return cache, rect, control, gate
+    @always_seq(clk.posedge, reset=rst)
+    def once_per_frame():
+        # the cache pulses at every read of an overwritten line (hundreds in a frame); the frame is dropped once
+        overrun.next = c_overrun and not told
+        if go:
+            told.next = False
+        elif c_overrun:
+            told.next = True
+
+    return cache, rect, control, gate, once_per_frame

@@ -52,10 +52,10 @@ def uart_bridge(clk, rst, rx, tx, bus, errors, *, clocks_per_bit: int = DEFAULT_
     Flow, and the receive FIFO's limit: a read burst sends 5 bytes per word, the next word's bus read
     overlapping the current word's bytes (the line stays busy while each read takes less than about 4
     byte times, 40 x ``clocks_per_bit`` clocks). A write burst's data keep coming while the bridge writes:
-    the received bytes wait in a FIFO of ``fifo`` bytes (LUT-RAM) plus the receiver's byte, so a write
-    may wait on the bus up to ``fifo`` byte times (16 bytes at 3 Mbaud: 53 us) without loss, and the
-    writes must average no more than 4 byte times each (a word's 4 bytes). Beyond that a byte is lost:
-    it is counted as an error and the request goes wrong (it ends in a timeout); a host that cannot
+    the received bytes wait in a FIFO of ``fifo`` bytes (LUT-RAM) plus the receiver's byte and the head
+    register's, so a write may wait on the bus up to ``fifo`` byte times (16 bytes at 3 Mbaud: 53 us)
+    without loss, and the writes must average no more than 4 byte times each (a word's 4 bytes). Beyond
+    that a byte is lost: it is counted as an error and the request goes wrong (it ends in a timeout); a host that cannot
     bound the bus's wait sends at most ``fifo // 4`` words ahead of the resp bytes it has received. The
     host must read each reply before its next request exceeds the FIFO (SerialBus does).
 
@@ -82,10 +82,10 @@ def uart_bridge(clk, rst, rx, tx, bus, errors, *, clocks_per_bit: int = DEFAULT_
             1 ms at 100 MHz); more than 2 byte times (20 x ``clocks_per_bit``), at most 2**31 - 1.
         fifo: receive FIFO bytes, 2..1024 (default 16).
 
-    Latency: an identify reply's start bit 3 clocks after the receiver delivers the 'I' (the FIFO, the
-    request machine, the transmitter); a read's first bus access 2 clocks after the count byte is
-    delivered, its data's first byte on the line as soon as the 'r' has gone out; a write's bus access
-    2 clocks after its fourth data byte is delivered.
+    Latency: an identify reply's start bit 4 clocks after the receiver delivers the 'I' (the FIFO, the head
+    register, the request machine, the transmitter); a read's first bus access 3 clocks after the count byte
+    is delivered, its data's first byte on the line as soon as the 'r' has gone out; a write's bus access
+    3 clocks after its fourth data byte is delivered.
 
     Resources: uart_rx, uart_tx, the FIFO (8 x ``fifo`` LUT-RAM bits), the 32-bit address shift register,
     address, data and reply registers, the timeout counter, the error counter. The catalogue's
@@ -111,10 +111,14 @@ def uart_bridge(clk, rst, rx, tx, bus, errors, *, clocks_per_bit: int = DEFAULT_
     rx_bytes = ByteStream()
     frame_error, overrun = Signal(bool(0)), Signal(bool(0))
     receiver = uart_rx(clk, rst, rx, rx_bytes, frame_error, overrun, clocks_per_bit=cpb)
-    push, pop = Signal(bool(0)), Signal(bool(0))
-    head = Signal(intbv(0)[8:])
+    push, pop, q_pop = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
+    q_head = Signal(intbv(0)[8:])
+    # the request machine reads its byte from a register (head, valid while has_head) that the FIFO fills: the
+    # LUT-RAM's read and the compares behind it in one clock were the board's slowest memory-clock path (a
+    # byte every other clock at most, the line brings one every 10 x clocks_per_bit)
+    head, has_head = Signal(intbv(0)[8:]), Signal(bool(0))
     level = Signal(intbv(0, min=0, max=depth + 1))
-    queue = show_ahead_fifo(clk, rst, rx_bytes.data, push, head, pop, level, depth=depth)
+    queue = show_ahead_fifo(clk, rst, rx_bytes.data, push, q_head, q_pop, level, depth=depth)
 
     # reply sender -> transmitter: tx_first is the next byte to send, tx_rest the (up to 4) after it
     tx_bytes = ByteStream()
@@ -147,8 +151,9 @@ def uart_bridge(clk, rst, rx, tx, bus, errors, *, clocks_per_bit: int = DEFAULT_
         rx_bytes.ready.next = level != depth
         push.next = rx_bytes.valid and level != depth
         waiting.next = state == st.S_ADDR or state == st.S_COUNT or state == st.S_STRB or state == st.S_WDATA
-        pop.next = level != 0 and ((state == st.S_IDLE and tx_left == 0) or state == st.S_ADDR or state == st.S_COUNT
-                                   or state == st.S_STRB or state == st.S_WDATA)
+        pop.next = has_head and ((state == st.S_IDLE and tx_left == 0) or state == st.S_ADDR or state == st.S_COUNT
+                                 or state == st.S_STRB or state == st.S_WDATA)
+        q_pop.next = level != 0 and not has_head
         tx_bytes.valid.next = tx_left != 0
         tx_bytes.data.next = tx_first
 
@@ -160,8 +165,14 @@ def uart_bridge(clk, rst, rx, tx, bus, errors, *, clocks_per_bit: int = DEFAULT_
             tx_first.next = tx_rest[32:24]
             tx_rest.next = concat(tx_rest[24:0], intbv(0)[8:])
             tx_left.next = tx_left - 1
-        # the timeout: clocks a request waits for a byte with the FIFO empty
-        if waiting and level == 0:
+        # the head register: filled from the FIFO, emptied by the machine's pop
+        if q_pop:
+            head.next = q_head
+            has_head.next = 1
+        elif pop:
+            has_head.next = 0
+        # the timeout: clocks a request waits for a byte with the FIFO and the head register empty
+        if waiting and level == 0 and not has_head:
             if timer == tmo - 1:
                 timer.next = 0
                 state.next = st.S_TMO

@@ -150,7 +150,7 @@ def stereo_frontend(clk, rst, hclk, hrst, cam_l, wrst_l, cam_r, wrst_r, bus, sra
             sequencer's modes are the same: a stereo frame is "held" when both cameras have begun one (the
             sequential mode's arming waits for frames that begin after it); a frame whose lines the cameras
             overwrote before the rectifier read them (the cache too small, or the cameras too far apart) still
-            runs through and is counted in both DROPPED registers.
+            runs through and is counted, once, in both DROPPED registers.
         cache_lines: the line cache's lines per camera (``rectify="stream"``); default: the calibration's plan
             (:func:`eyestereo.tools.models.line_cache.plan`).
         memory: ``"sram"`` (default, the EyeBot's 1M x 18 synchronous SRAM: ``sram`` is

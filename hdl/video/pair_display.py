@@ -4,14 +4,17 @@ from __future__ import annotations
 
 import numbers
 
-from myhdl import ConcatSignal, Signal, always, always_comb, always_seq, block, enum, intbv
+from myhdl import ConcatSignal, Signal, always, always_comb, always_seq, block, concat, enum, intbv
 
 from eyestereo.hdl.common.checks import block_error, check_bool, check_clock, check_int, check_reset, check_signal
 from eyestereo.hdl.interfaces.axil import check_axil
 from eyestereo.hdl.video.video_timing import video_timing
 from eyestereo.tools.models.feature_list import MARKER
-from eyestereo.tools.models.pair_display import (CROSS, MARK, PIXEL_MAX, SRAM_BASE, check_geometry, ctrl_words,
-                                                 start_words)
+from eyestereo.tools.models.match_engine import MARKER as MATCH_MARKER
+from eyestereo.tools.models.match_engine import MATCH, MAX_MATCHES
+from eyestereo.tools.models.pair_display import (CROSS, MARK, PIXEL_MAX, SEGMENT_RGB, SRAM_BASE, check_geometry,
+                                                 ctrl_words, start_words)
+from eyestereo.tools.models.sram_arbiter import match_offset
 from eyestereo.tools.models.video_timing import MODES
 from eyestereo.tools.regmap import REGMAP
 
@@ -38,8 +41,9 @@ def pd_sync(clk, rst, tog, pulse):
 
 #: Entries of one mark-plane bank: one ECP5 DP16KD as 16384 x 1.
 PLANE_BANK = 1 << 14
-#: Clocks from a plane read address to its bit (the bank's read, the bank's output register, the bank mux's).
-PLANE_LATENCY = 3
+#: Clocks from the pixel index to its mark bit: the read address's register, the bank's read, the bank's output
+#: register, the bank multiplexer's.
+PLANE_LATENCY = 4
 
 
 @block
@@ -64,8 +68,9 @@ def pd_bank(clk, we, waddr, wval, raddr, q, *, depth: int):
 
 @block
 def pd_plane(clk, we, waddr, wval, raddr, q, *, depth: int):
-    """A ``depth`` x 1 mark plane in banks of :data:`PLANE_BANK` (one block RAM each), read with
-    :data:`PLANE_LATENCY` clocks: each bank's bit from its output register, then the bank chosen into ``q``. A
+    """A ``depth`` x 1 mark plane in banks of :data:`PLANE_BANK` (one block RAM each), read in three clocks
+    (the display's address register makes :data:`PLANE_LATENCY`): each bank's bit from its output register, then
+    the bank chosen into ``q``. A
     single memory of 76,800 bits put the multiplexer of its block RAMs between their outputs and the next
     flip-flop: that path was the memory clock's slowest on the board (12.9 ns)."""
     banks = (depth + PLANE_BANK - 1) // PLANE_BANK
@@ -113,7 +118,8 @@ def pd_plane(clk, we, waddr, wval, raddr, q, *, depth: int):
 def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de, red, green, blue, *, width: int = 320,
                  height: int = 240, rect_base: tuple[int, int] = (0, 76800),
                  feat_base: tuple[int, int] = (153600, 155648), max_features: int = 1023, mode: str = "640x480@60",
-                 poll_gap: int = 64, polls: int = 4096, autostart: bool = False):
+                 poll_gap: int = 64, polls: int = 4096, autostart: bool = False, matches: bool = False,
+                 max_matches: int = 1023):
     """The newest rectified pair and its corners on a monitor: a copy of the pair in block RAM, taken over the
     register bus as the host would, shown in the pixel clock.
 
@@ -136,6 +142,13 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
     with 320x240 images) is never overtaken (an estimate from the mode's timing, not a measurement). The copy
     reads the list first and draws each corner's cross into a 1-bit mark plane per camera, then writes every pixel
     with its mark in one write (code 255 where the plane says so): a pixel and its mark change together.
+
+    Matches (``matches``, the front end's matcher option): after the features the copy reads the frame's match list
+    from the list buffer's word :func:`~eyestereo.tools.models.sram_arbiter.match_offset` (``max_features``) on,
+    three words a match (:data:`~eyestereo.tools.models.match_engine.MATCH`) up to its trailer, and draws each
+    match's :func:`~eyestereo.tools.models.pair_display.segment` (the left corner's row, from x - disparity to x,
+    one pixel a clock) into a third plane; its bits are copied with the pixels into a 1-bit RAM, and the anaglyph
+    shows them in :data:`~eyestereo.tools.models.pair_display.SEGMENT_RGB` (a corner's mark wins).
 
     Ports:
         clk, rst: the bus clock (the memory clock) and its synchronous reset.
@@ -161,14 +174,19 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
             (no pair came: the cameras stopped); the wants are withdrawn then.
         autostart: False (default) or True: after reset, first start the front end as a board without a host needs
             it: CTRL's mode and continuous bits (overlapped, continuous; byte 0 alone) and CMD.start.
+        matches: False (default) or True: draw the match list's segments (the front end built with
+            ``matcher=True``; its list buffers hold the match list after the features).
+        max_matches: the longest match list drawn (1..32767); a list without its trailer is cut there.
 
     Latency: a pixel is shown 2 pixel clocks after video_timing's outputs (RAM read, colour register); sync and
     ``de`` are delayed with it. A copy takes about ``width x height`` reads of the SRAM window (each a bank read
-    plus the memory's wait) and 9 writes per listed corner.
+    plus the memory's wait) and 9 writes per listed corner; with ``matches``, 3 reads and disparity + 2 clocks per
+    match.
 
     Resources: two ``width x height x 8`` block RAMs (320x240: 38 DP16KD each on the ECP5), two ``width x
     height`` x 1 mark planes in banks of 16,384 (5 DP16KD each), the FSM, constant multipliers for the scan and the
-    crosses' addresses (the whole board's figures: docs/boards.md).
+    crosses' addresses; with ``matches`` a third plane and a ``width x height`` x 1 RAM (5 + 5 DP16KD at 320x240)
+    (the whole board's figures: docs/boards.md).
     """
     check_clock(clk)
     check_reset(rst)
@@ -187,6 +205,8 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
     check_int("poll_gap", poll_gap, 1, 1 << 16)
     check_int("polls", polls, 1, 1 << 20)
     autostart = check_bool("autostart", autostart)
+    matches = check_bool("matches", matches)
+    max_matches = check_int("max_matches", max_matches, 1, MAX_MATCHES)
     for name, pair in (("rect_base", rect_base), ("feat_base", feat_base)):
         if not isinstance(pair, (tuple, list)) or len(pair) != 2 or any(
                 isinstance(v, bool) or not isinstance(v, numbers.Integral) or not 0 <= v < (1 << 20) for v in pair):
@@ -216,6 +236,10 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
     n_cross = len(CROSS)
     cdx = tuple(dx for dx, _ in CROSS)
     cdy = tuple(dy for _, dy in CROSS)
+    moff = match_offset(max_features)  # the match list's first word in a list buffer
+    mx_hi, mx_lo = MATCH.bits("x")
+    my_hi, my_lo = MATCH.bits("y")
+    md_hi, md_lo = MATCH.bits("disparity")
 
     ram_l = [Signal(intbv(0)[8:]) for _ in range(npix)]
     ram_r = [Signal(intbv(0)[8:]) for _ in range(npix)]
@@ -228,12 +252,13 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
     mark_l, mark_r = Signal(bool(0)), Signal(bool(0))
     mwait = Signal(intbv(0, min=0, max=MARK_DRAIN + PLANE_LATENCY + 1))
     paddr = Signal(intbv(0)[pbits:])
-    p1_valid, p1_cam, p2_we, p2_cam = (Signal(bool(0)) for _ in range(4))
+    p1_valid, p2_we = Signal(bool(0)), Signal(bool(0))
+    p1_cam, p2_cam = Signal(intbv(0)[2:]), Signal(intbv(0)[2:])  # the plane: 0 left, 1 right, 2 the matches
     p2_addr = Signal(intbv(0)[pbits:])
 
     # ---------------------------------------------------------------- bus clock: the copy
     st = enum("S_BOOT", "S_START", "S_IDLE", "S_WR", "S_WR_B", "S_POLL", "S_POLL_R", "S_GAP", "S_PIX", "S_PIX_R",
-              "S_FEAT", "S_FEAT_R", "S_MARK", "S_UNWANT")
+              "S_FEAT", "S_FEAT_R", "S_MARK", "S_UNWANT", "S_MATCH", "S_MATCH_R", "S_SEG0", "S_SEG")
     state = Signal(st.S_BOOT if autostart else st.S_IDLE)
     awv, wv, rr = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
     resume = Signal(st.S_IDLE)  # where a register write goes when its response came
@@ -245,7 +270,7 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
     tries = Signal(intbv(0, min=0, max=polls + 1))
     rbase = Signal(intbv(0)[20:])
     fbase = Signal(intbv(0)[20:])
-    idx = Signal(intbv(0, min=0, max=max(npix, 2 * max_features + 2) + 1))
+    idx = Signal(intbv(0, min=0, max=max(npix, moff + 3 * max_matches + 3) + 1))
     half = Signal(bool(0))  # the feature word read is the entry's second (y)
     fx = Signal(intbv(0)[15:])
     fcam = Signal(bool(0))
@@ -260,6 +285,14 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
     yk = Signal(intbv(0, min=-reach, max=(1 << 16) + reach))
     p1_x = Signal(intbv(0, min=-reach, max=(1 << 15) + reach))
     p1_y = Signal(intbv(0, min=-reach, max=(1 << 16) + reach))
+    # the match list: a match's three words, the segment being drawn (columns seg_x .. seg_end of row seg_y)
+    mw = Signal(intbv(0)[MATCH.width:])
+    mword = Signal(intbv(0, min=0, max=3))
+    nmatch = Signal(intbv(0, min=0, max=max_matches + 1))
+    seg_x = Signal(intbv(0)[mx_hi - mx_lo:])
+    seg_end = Signal(intbv(0)[mx_hi - mx_lo:])
+    seg_y = Signal(intbv(0)[my_hi - my_lo:])
+    m_we_m, mark_m = Signal(bool(0)), Signal(bool(0))
 
     sync = pd_sync(clk, rst, tog, start)
 
@@ -420,7 +453,14 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
         elif state == st.S_FEAT_R:
             if bus.rvalid:
                 if not half:
-                    if bus.rdata[16:0] == MARKER:
+                    if bus.rdata[16:0] == MARKER and matches:
+                        state.next = st.S_MATCH  # the trailer: the match list next
+                        idx.next = moff
+                        mword.next = 0
+                        nmatch.next = 0
+                        bus.araddr.next = SRAM_BASE + 4 * (fbase + moff)
+                        bus.arvalid.next = 1
+                    elif bus.rdata[16:0] == MARKER:
                         state.next = st.S_PIX  # the trailer: the list is done, the pixels next
                         idx.next = 0
                         bus.araddr.next = SRAM_BASE + 4 * rbase
@@ -448,7 +488,13 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
                 nfeat.next = nfeat + 1
                 bus.arvalid.next = 1
                 rr.next = 1
-                if nfeat == max_features - 1:
+                if nfeat == max_features - 1 and matches:
+                    idx.next = moff
+                    mword.next = 0
+                    nmatch.next = 0
+                    bus.araddr.next = SRAM_BASE + 4 * (fbase + moff)
+                    state.next = st.S_MATCH
+                elif nfeat == max_features - 1:
                     idx.next = 0
                     bus.araddr.next = SRAM_BASE + 4 * rbase
                     rr.next = 0
@@ -460,6 +506,59 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
                     state.next = st.S_FEAT
             else:
                 k.next = k + 1
+        elif state == st.S_MATCH:
+            if bus.arready:
+                bus.arvalid.next = 0
+                state.next = st.S_MATCH_R
+        elif state == st.S_MATCH_R:
+            if bus.rvalid:
+                if mword == 0 and bus.rdata[16:0] == MATCH_MARKER:
+                    # the trailer: the pixels next (the last segment's writes drain meanwhile)
+                    state.next = st.S_PIX
+                    idx.next = 0
+                    bus.araddr.next = SRAM_BASE + 4 * rbase
+                    bus.arvalid.next = 1
+                    rr.next = 0
+                    mwait.next = MARK_DRAIN + PLANE_LATENCY
+                else:
+                    mw.next = concat(bus.rdata[16:0], mw[MATCH.width:16])  # low word first
+                    if mword == 2:
+                        mword.next = 0
+                        rr.next = 0
+                        state.next = st.S_SEG0
+                    else:
+                        mword.next = mword + 1
+                        idx.next = idx + 1
+                        bus.araddr.next = SRAM_BASE + 4 * (fbase + idx + 1)
+                        bus.arvalid.next = 1
+                        state.next = st.S_MATCH
+        elif state == st.S_SEG0:
+            # the segment: from the right corner's column (x - disparity; columns left of the image are not drawn,
+            # so it starts at 0 there: unsigned arithmetic alone) to the left corner's
+            seg_x.next = 0
+            if mw[mx_hi:mx_lo] >= mw[md_hi:md_lo]:
+                seg_x.next = mw[mx_hi:mx_lo] - mw[md_hi:md_lo]
+            seg_end.next = mw[mx_hi:mx_lo]
+            seg_y.next = mw[my_hi:my_lo]
+            state.next = st.S_SEG
+        elif state == st.S_SEG:
+            # one pixel a clock into the match plane (the marks' pipeline, plane 2)
+            if seg_x == seg_end:
+                nmatch.next = nmatch + 1
+                if nmatch == max_matches - 1:
+                    idx.next = 0
+                    bus.araddr.next = SRAM_BASE + 4 * rbase
+                    bus.arvalid.next = 1
+                    mwait.next = MARK_DRAIN + PLANE_LATENCY
+                    state.next = st.S_PIX
+                else:
+                    idx.next = idx + 1
+                    bus.araddr.next = SRAM_BASE + 4 * (fbase + idx + 1)
+                    bus.arvalid.next = 1
+                    rr.next = 1
+                    state.next = st.S_MATCH
+            else:
+                seg_x.next = seg_x + 1
 
     @always_comb
     def cross_rom():
@@ -487,9 +586,10 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
         if we_r:
             ram_r[int(w_addr)].next = w_r
 
-    @always_comb
+    @always(clk.posedge)
     def plane_read():
-        # idx counts feature words too (up to 2 x max_features + 2): only a pixel's index reads the planes
+        # idx counts feature words too (up to 2 x max_features + 2): only a pixel's index reads the planes. A
+        # register: the compare in front of the banks' read addresses was the memory clock's slowest path
         paddr.next = 0
         if idx < npix:
             paddr.next = idx
@@ -498,10 +598,16 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
     def mark_pipe():
         # stage 1: the cross pixel's coordinates; stage 2: inside the image?, its address (registered: the
         # constant multiply and the compares stay off the RAM's write port)
-        p1_valid.next = state == st.S_MARK and k < n_cross
-        p1_x.next = xk
-        p1_y.next = yk
-        p1_cam.next = fcam
+        if state == st.S_SEG:
+            p1_valid.next = 1
+            p1_x.next = seg_x
+            p1_y.next = seg_y
+            p1_cam.next = 2
+        else:
+            p1_valid.next = state == st.S_MARK and k < n_cross
+            p1_x.next = xk
+            p1_y.next = yk
+            p1_cam.next = fcam
         p2_we.next = 0
         p2_addr.next = 0
         p2_cam.next = p1_cam
@@ -516,21 +622,44 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
         m_addr.next = 0
         m_we_l.next = 0
         m_we_r.next = 0
+        m_we_m.next = 0
         m_val.next = 0
         if p2_we:
             m_addr.next = p2_addr
             m_val.next = 1
-            if p2_cam:
+            if p2_cam == 2:
+                m_we_m.next = 1
+            elif p2_cam == 1:
                 m_we_r.next = 1
             else:
                 m_we_l.next = 1
-        elif state == st.S_PIX_R and bus.rvalid:
+        elif state == st.S_PIX_R and bus.rvalid and rr:
+            # cleared as the pixel is written (not while its read waits for the mark: rr low)
             m_addr.next = idx
             m_we_l.next = 1
             m_we_r.next = 1
+            m_we_m.next = 1
 
     planes = [pd_plane(clk, m_we_l, m_addr, m_val, paddr, mark_l, depth=npix),
               pd_plane(clk, m_we_r, m_addr, m_val, paddr, mark_r, depth=npix)]
+    pm = Signal(bool(0))  # pixel clock: the scan's match bit
+    if matches:
+        ram_m = [Signal(bool(0)) for _ in range(npix)]
+        planes.append(pd_plane(clk, m_we_m, m_addr, m_val, paddr, mark_m, depth=npix))
+
+        @always(clk.posedge)
+        def write_m():
+            if we_l:
+                ram_m[int(w_addr)].next = mark_m
+
+        planes.append(write_m)
+    else:
+        @always(clk.posedge)
+        def no_match_plane():
+            # without the option the match bit is 0 (a flip-flop: MyHDL declares only driven signals)
+            mark_m.next = 0
+
+        planes.append(no_match_plane)
 
     # ---------------------------------------------------------------- pixel clock: the scan
     vhs, vvs, vde = Signal(bool(0)), Signal(bool(0)), Signal(bool(0))
@@ -573,6 +702,15 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
         pl.next = ram_l[int(raddr)]
         pr.next = ram_r[int(raddr)]
 
+    if matches:
+        @always(pclk.posedge)
+        def read_m():
+            pm.next = ram_m[int(raddr)]
+    else:
+        @always(pclk.posedge)
+        def read_m():
+            pm.next = 0
+
     @always_seq(pclk.posedge, reset=prst)
     def stage1():
         hs1.next = vhs
@@ -613,10 +751,14 @@ def pair_display(clk, rst, pclk, prst, bus, run, copies, idle, hsync, vsync, de,
             if pl == MARK or pr == MARK:
                 red.next = 255
                 green.next = 255
+            elif pm:
+                red.next = SEGMENT_RGB[0]
+                green.next = SEGMENT_RGB[1]
+                blue.next = SEGMENT_RGB[2]
             else:
                 red.next = pl
                 green.next = pr
                 blue.next = pr
 
     return (sync, copy, cross_rom, cross_pos, outs, write, plane_read, mark_pipe, plane_port, planes, timing,
-            anaglyph_row, scan_addr, read, stage1, stage2)
+            anaglyph_row, scan_addr, read, read_m, stage1, stage2)

@@ -15,12 +15,15 @@ waits two frames, takes a pair and its features (the display stopped meanwhile, 
 next copies go to the monitor; the TMDS pins are recorded for ``monitor_frames`` frames and decoded.
 
 Checks: the pair and the features the host read equal the numpy model's (the rectifier, stereo Harris and feature
-list models on the camera frames); the last decoded HDMI frame equals the model's picture of that pair and those
-features (:func:`eyestereo.tools.models.pair_display.picture`); the SCCB slaves recorded exactly the table and the
+list models on the camera frames); with the top's ``matcher`` the match list the host read equals the feature
+matcher model's on that pair (the MATCH register's reset settings); the last decoded HDMI frame equals the model's
+picture of that pair, those features and those matches' segments
+(:func:`eyestereo.tools.models.pair_display.picture`); the SCCB slaves recorded exactly the table and the
 board reports both cameras present; no SDRAM rule broken; no serial-link error; the LEDs say locked and present.
 
-Config: ``params`` (the board top's), ``frames`` (camera frames played), ``target``, ``k``, ``monitor_frames``,
-``cam_mhz`` (the camera players' PCLK), ``timing`` (CameraTiming fields).
+Config: ``params`` (the board top's), ``frames`` (camera frames played), ``scene`` (:func:`stereo_frames`'s),
+``target``, ``k``, ``match`` (the MATCH settings the host writes: ``t_max``, ``uniqueness``, ``lr_check``),
+``monitor_frames``, ``cam_mhz`` (the camera players' PCLK), ``timing`` (CameraTiming fields).
 """
 
 from __future__ import annotations
@@ -36,7 +39,8 @@ from cocotb.types import LogicArray
 
 from eyestereo.sim.lib.bench import load_config, write_report
 from eyestereo.sim.lib.fast_system import write_script
-from eyestereo.sim.lib.frontend_model import choose_thresholds, model_params, stereo_frames
+from eyestereo.sim.lib.frontend_model import (choose_thresholds, match_list_of, match_settings, model_params,
+                                              stereo_frames)
 from eyestereo.sim.lib.harness_files import SCRIPT_FILES
 from eyestereo.sim.lib.sccb import SccbBus, SccbSlave
 from eyestereo.sim.lib.sdram_model import SdramModel
@@ -47,7 +51,8 @@ from eyestereo.tools.board.serial_bus import READ_PIECE, SerialBus
 from eyestereo.tools.camera import CameraTiming, frame_schedule
 from eyestereo.tools.models import stereo_frontend as model
 from eyestereo.tools.models.dvi_receiver import receive
-from eyestereo.tools.models.pair_display import copy_pair, picture
+from eyestereo.tools.models.match_engine import parse_list
+from eyestereo.tools.models.pair_display import copy_pair, match_plane, picture
 from eyestereo.tools.models.sram_arbiter import AddressMap, list_words
 from eyestereo.tools.models.video_timing import mode_of
 from eyestereo.tools.sdram import ULX3S
@@ -193,13 +198,18 @@ async def board_pair_to_monitor(dut):
     thr = choose_thresholds(tb.cal, [pair], k, cfg.get("target", 12), tb.mp)
     expect = model.stereo_frontend(tb.cal, pair[0], pair[1], k, [thr] * 16, **tb.mp)
     exp_feats = expect["list"]["features"]
+    msets = match_settings(cfg)  # None without the matcher
+    exp_matches = None
+    if msets:
+        ml = parse_list(match_list_of(expect, tb.mp, msets)["words"])
+        exp_matches = [(int(x), int(y), int(d), int(c), int(dy)) for (x, y, d, c), dy in zip(ml["matches"], ml["dy"])]
     await tb.start(pair)
 
     b = tb.board
     await b.check()
     st0 = await b.status()
     # the host area of the memory (above the buffers): a burst written, read back as a burst and word by word
-    amap_words = AddressMap(tb.w, tb.h, list_words(1023), cameras=False).host_base
+    amap_words = AddressMap(tb.w, tb.h, list_words(1023, 1023 if msets else None), cameras=False).host_base
     probe = [(0x1234 + 0x0101 * i) & 0xFFFF for i in range(40)]
     await b.fe.write_sram_words(amap_words, probe)
     back = await b.fe.read_sram_words(amap_words, len(probe))
@@ -210,16 +220,21 @@ async def board_pair_to_monitor(dut):
     assert (await tb.link.read(BOARD_BASE + 0x1C))[1] == 2
     assert await b.regs.read("BOARD_ID") == BOARD_REGMAP["BOARD_ID"].reset_value()
     await b.set_harris(k_left=k, k_right=k, thresholds_left=[thr] * 16, thresholds_right=[thr] * 16)
+    if msets:  # the matcher's run-time settings (MATCH), the model's
+        await b.fe.set(match_limit=msets["limit"], match_uniqueness=msets["uniqueness"],
+                       match_lr_check=int(msets["lr_check"]))
     f0 = await b.fe.read("FRAMES")
     await b.fe.wait_frame(after=f0, timeout_clocks=2_000_000, poll_clocks=20_000)
     f1 = await b.fe.wait_frame(timeout_clocks=2_000_000, poll_clocks=20_000)
     t_take = get_sim_time(unit="ns")
-    got = await b.take_pair()
+    got = await b.take_pair(matches=bool(msets))
     t_taken = get_sim_time(unit="ns")
     assert got.frame >= f1
     np.testing.assert_array_equal(got.left, expect["rectified"][0], err_msg="the rectified left image read over UART")
     np.testing.assert_array_equal(got.right, expect["rectified"][1], err_msg="the rectified right image")
     assert got.features == [tuple(f) for f in exp_feats], (got.features[:5], exp_feats[:5])
+    assert got.matches == exp_matches, (got.matches if got.matches is None else got.matches[:5],
+                                        exp_matches if exp_matches is None else exp_matches[:5])
     # the monitor: the display copies again after the host gave it back its run bit
     c0 = await b.regs.get("copies")
     for _ in range(200):
@@ -231,14 +246,15 @@ async def board_pair_to_monitor(dut):
     bits = await tb.record_tmds(cfg.get("monitor_frames", 2))
     cap = receive(list(bits), tb.mode)
     assert cap.frames, "no whole frame on the HDMI pins"
-    want = picture(*copy_pair(expect["rectified"][0], expect["rectified"][1], exp_feats), tb.mode)
+    ram_m = None if exp_matches is None else match_plane([m[:3] for m in exp_matches], tb.w, tb.h)
+    want = picture(*copy_pair(expect["rectified"][0], expect["rectified"][1], exp_feats), tb.mode, ram_m)
     last = cap.frames[-1]
     bad = np.argwhere((last != want).any(axis=2))
     if bad.size:  # kept in the run's folder for a look (numpy arrays: every frame decoded, the expected picture,
         # both rectified buffers as the memory holds them now)
         np.save("hdmi_frames.npy", np.asarray(cap.frames))
         np.save("hdmi_want.npy", want)
-        amap = AddressMap(tb.w, tb.h, list_words(1023), cameras=False)
+        amap = AddressMap(tb.w, tb.h, list_words(1023, 1023 if msets else None), cameras=False)
         for buf in (0, 1):
             words = await b.fe.read_sram_words(amap.rectified(buf), tb.w * tb.h)
             np.save(f"rect_buf{buf}.npy", np.asarray(words))
@@ -256,8 +272,11 @@ async def board_pair_to_monitor(dut):
     assert leds & 0b111 == 0b111, f"LEDs {leds:08b}: locked and both cameras present expected"
     tb.sdram.finish()
     assert not tb.sdram.violations, f"SDRAM rules broken: {tb.sdram.violations[:3]}"
-    write_report(cfg, dict(features=len(got.features), threshold=thr, frames_at_grab=got.frame,
+    write_report(cfg, dict(features=len(got.features), matches=None if got.matches is None else len(got.matches),
+                           segment_pixels=0 if ram_m is None else int(ram_m.sum()),
+                           threshold=thr, frames_at_grab=got.frame,
                            hdmi_frames=len(cap.frames), copies=st["copies"], status_at_start=st0,
                            requests=tb.link.requests, dropped=(st["dropped_left"], st["dropped_right"]),
+                           frames=st["frames"],
                            sim_wall_s=round(time.perf_counter() - t_wall, 1),
                            sim_time_ns=get_sim_time(unit="ns"), take_start_ns=t_take, take_ns=t_taken - t_take))

@@ -9,9 +9,15 @@ frame must equal the model's picture (``tools.models.pair_display``: ``picture``
 features, numpy, from the config), and the sync signals must follow the mode
 (:func:`eyestereo.tools.models.video_timing.signals`) two pixel clocks late.
 
+With the block's ``matches`` parameter the list buffer also holds a match list after the features (from
+:func:`~eyestereo.tools.models.sram_arbiter.match_offset`: random matches, some reaching past the image's left edge,
+packed by :data:`~eyestereo.tools.models.match_engine.MATCH`, and the trailer), and the expected picture has their
+segments (``match_plane``).
+
 Config: ``params`` (the block's), ``seed``, ``features`` (how many random corners, some on the border),
-``rect_buf``/``feat_buf`` (the buffers held), ``hold_delay``, ``frames`` (whole frames to check after the copy),
-``absent`` (no pair ever becomes held: the display must give up and withdraw its wants).
+``matches`` (how many random matches, with ``params["matches"]``), ``rect_buf``/``feat_buf`` (the buffers held),
+``hold_delay``, ``frames`` (whole frames to check after the copy), ``absent`` (no pair ever becomes held: the
+display must give up and withdraw its wants).
 """
 
 from __future__ import annotations
@@ -25,7 +31,10 @@ from cocotbext.axi import AxiLiteBus, AxiLiteSlave
 from eyestereo.sim.lib.axil import AxiLiteChecker
 from eyestereo.sim.lib.bench import load_config, write_report
 from eyestereo.tools.models.feature_list import MARKER
-from eyestereo.tools.models.pair_display import SRAM_BASE, copy_pair, ctrl_words, picture, start_words
+from eyestereo.tools.models.match_engine import MARKER as MATCH_MARKER
+from eyestereo.tools.models.match_engine import MATCH, TRAILER
+from eyestereo.tools.models.pair_display import SRAM_BASE, copy_pair, ctrl_words, match_plane, picture, start_words
+from eyestereo.tools.models.sram_arbiter import match_offset
 from eyestereo.tools.models.video_timing import mode_of, signals
 from eyestereo.tools.regmap import REGMAP
 
@@ -108,6 +117,19 @@ async def pair_display_picture(dut):
         words[feat_base[fb] + 2 * i + 1] = y
     words[feat_base[fb] + 2 * len(feats)] = MARKER
     words[feat_base[fb] + 2 * len(feats) + 1] = len(feats)
+    matches = []
+    if p.get("matches"):
+        # (x, y, disparity): some segments reach past the left edge (x < disparity), one is a single pixel
+        matches = [(int(rng.integers(0, w)), int(rng.integers(0, h)), int(rng.integers(0, 12)))
+                   for _ in range(cfg.get("matches", 6))] + [(2, h - 1, 9), (w - 1, 0, 0)]
+        base = feat_base[fb] + match_offset(p["max_features"])
+        for i, (x, y, d) in enumerate(matches):
+            v = int(MATCH.pack(x=x, dy=int(rng.integers(-1, 2)), y=y, disparity=d, cost=int(rng.integers(0, 4096))))
+            for j in range(3):
+                words[base + 3 * i + j] = (v >> (16 * j)) & 0xFFFF
+        t = int(TRAILER.pack(marker=MATCH_MARKER, count=len(matches), overflow=0, candidates=3 * len(matches)))
+        for j in range(3):
+            words[base + 3 * len(matches) + j] = (t >> (16 * j)) & 0xFFFF
     fe = FrontEnd(words, rect_buf=rb, feat_buf=fb, hold_delay=cfg.get("hold_delay", 3),
                   absent=cfg.get("absent", False))
 
@@ -154,7 +176,8 @@ async def pair_display_picture(dut):
     assert int(dut.copies.value) >= 1, "no copy within 10 frames"
     n_frames = cfg.get("frames", 1)
     await ClockCycles(dut.pclk, (n_frames + 2) * frame)
-    exp = picture(*copy_pair(left, right, feats), mode)
+    ram_m = match_plane(matches, w, h, max_matches=p.get("max_matches", 1023)) if p.get("matches") else None
+    exp = picture(*copy_pair(left, right, feats), mode, ram_m)
     ref = signals(mode, frame * (len(rows) // frame + 2))  # the mode's own sync, de and coordinates
     # align: the block's outputs are the timing generator's two pixel clocks later
     sync = np.array([r[:3] for r in rows])
@@ -173,7 +196,7 @@ async def pair_display_picture(dut):
         img = pix.reshape(mode.v_active, mode.h_active, 3)
         bad = np.argwhere((img != exp).any(axis=2))
         assert bad.size == 0, f"{len(bad)} pixels differ, first at (y, x) = {tuple(bad[0])}: {img[tuple(bad[0])]} " \
-                              f"!= {exp[tuple(bad[0])]}"
+                              f"!= {exp[tuple(bad[0])]}; the first ten (y, x): {[tuple(map(int, b)) for b in bad[:10]]}"
         for name, col in (("hsync", 0), ("vsync", 1)):
             want = np.asarray(ref[name][f0 - lat:f0 - lat + frame], dtype=int)
             assert np.array_equal(sync[f0:f0 + frame, col], want), f"{name} differs from the mode's"
@@ -194,4 +217,5 @@ async def pair_display_picture(dut):
     assert fe.releases == int(dut.copies.value), (fe.releases, int(dut.copies.value))
     checker.check()
     write_report(cfg, dict(frames_checked=checked, latency=lat, copies=int(dut.copies.value),
-                           sram_reads=fe.sram_reads, writes=len(writes)))
+                           sram_reads=fe.sram_reads, writes=len(writes),
+                           segment_pixels=0 if ram_m is None else int(ram_m.sum())))

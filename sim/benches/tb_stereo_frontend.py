@@ -53,8 +53,8 @@ from cocotb.triggers import ClockCycles, Edge, Timer
 from eyestereo.sim.lib.axil import AxiLiteHost
 from eyestereo.sim.lib.bench import load_config, write_report
 from eyestereo.sim.lib.camera import CameraModel
-from eyestereo.sim.lib.frontend_model import (choose_thresholds, frame_digest, model_params, pair_frames,
-                                              stereo_frames)
+from eyestereo.sim.lib.frontend_model import (choose_thresholds, frame_digest, match_list_of, match_settings,
+                                              model_params, pair_frames, stereo_frames)
 from eyestereo.sim.lib.sdram_model import SdramModel
 from eyestereo.sim.lib.sram_model import SramModel
 from eyestereo.tools.camera import CameraTiming, frame_schedule
@@ -385,40 +385,6 @@ async def frames_bit_exact(dut):
                            arb_words=list(ARB_WORDS), total_ns=get_sim_time(unit="ns") - t_start,
                            camera_frame_pclk=timing.frame_pclk, axi=bus.checker.counts, last=last,
                            stages=stage_times(events, [r["start_ns"] for r in results])))
-
-
-def match_settings(cfg: dict) -> dict | None:
-    """The matcher option's model settings (None without it): the top's parameters (``match_cost``,
-    ``match_window``, ``match_d_max``, ``match_rows``, ``max_matches``, else the top's defaults) and the run-time
-    settings the host writes into MATCH (config ``match``: ``t_max`` or ``h_max``, ``uniqueness``, ``lr_check``;
-    defaults t_max 11, h_max 15, 0, True), with the ``limit`` they give."""
-    p = cfg["params"]
-    if not p.get("matcher"):
-        return None
-    from eyestereo.hdl.system.stereo_frontend import stereo_frontend as top
-    from eyestereo.tools.models.feature_matcher import cost_limit
-
-    sig = inspect.signature(top).parameters
-    top_p = {n: p.get(n, sig[n].default) for n in ("match_cost", "match_window", "match_d_max", "match_rows",
-                                                   "max_matches")}
-    run = dict(dict(t_max=11, h_max=15, uniqueness=0, lr_check=True), **cfg.get("match", {}))
-    return dict(cost=top_p["match_cost"], window=top_p["match_window"], d_max=top_p["match_d_max"],
-                rows=top_p["match_rows"], max_matches=top_p["max_matches"], **run,
-                limit=cost_limit(top_p["match_cost"], top_p["match_window"], run["t_max"], run["h_max"]))
-
-
-def match_list_of(m: dict, mp: dict, ms: dict) -> dict:
-    """The feature matcher model's list for a pair of the front end's model (``m``): its rectified images and the
-    corners of its flags inside the feature list's border."""
-    from eyestereo.tools.models.corner_descriptors import corners
-    from eyestereo.tools.models.feature_matcher import feature_matcher
-    from eyestereo.tools.models.harris_mono import radius
-
-    border = mp["border"] if mp["border"] is not None else radius(mp["nms"])  # the feature list's (the model's rule)
-    fl, fr = (corners(f, border) for f in m["flags"][:2])
-    return feature_matcher(*m["rectified"], fl, fr, window=ms["window"], cost=ms["cost"], t_max=ms["t_max"],
-                           h_max=ms["h_max"], d_min=0, d_max=ms["d_max"], rows=ms["rows"], uniqueness=ms["uniqueness"],
-                           lr_check=bool(ms["lr_check"]), max_matches=ms["max_matches"])
 
 
 def dense_settings(cfg: dict) -> dict | None:

@@ -4,8 +4,8 @@ Two camera queues play frames with a camera's timing (:class:`eyestereo.tools.ca
 pixel clock, in memory clocks; the right camera ``skew`` lines behind the left), never held back; the
 rectified stereo stream is recorded beat by beat. Checked: every frame's beats (data, cam, eol, eof) equal to
 the rectification model of that frame's two camera images; ``overrun`` never pulses (or, with
-``expect_overrun``, that it does: a cache too small for the calibration is caught); the block idle and
-nothing left over at the end.
+``expect_overrun``, that it pulses once in each frame rectified: a cache too small for the calibration is
+caught); the block idle and nothing left over at the end.
 
 Configuration: ``images`` (a list of ``"random:SEED"`` / ``"file:NAME"`` specs, one per frame, or one for all),
 ``frames``, ``timing`` (CameraTiming fields; default: CIF blanking at the calibration's camera size),
@@ -140,7 +140,11 @@ async def stream_rectifier_frames(dut):
     report = dict(width=cal.width, height=cal.height, frames=frames, beats=len(tb.beats), overruns=tb.overruns,
                   line_ns=tb.line_ns, frame_ns=tb.frame_ns)
     if expect_overrun:
+        # every frame overran (a cache too small for the calibration): one pulse per frame, not per read
+        done = len(tb.beats) // (2 * npx)
+        report["frames_rectified"] = done
         assert tb.overruns > 0, "the cache was too small for the calibration, and overrun never pulsed"
+        assert tb.overruns == done, f"overrun pulsed {tb.overruns} times in {done} rectified frames (once a frame)"
         report["bit_exact"] = None
         write_report(cfg, report)
         return

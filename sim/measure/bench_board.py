@@ -22,8 +22,8 @@ from eyestereo.tools.io import write_section
 
 #: The run of tests/boards/test_board_sim.py (kept equal by tests/boards/test_board_sim.py importing them).
 PARAMS = dict(quantizers="rig:32x24", mode="sim-64x48", clocks_per_bit=8, sccb_table=((0x11, 0x00), (0x40, 0xD0)),
-              sccb_hz=400e3)
-CONFIG = dict(frames=400, target=12, k=10, monitor_frames=2, cam_mhz=12.5,
+              sccb_hz=400e3, matcher=True, match_rows=1)
+CONFIG = dict(frames=400, target=12, k=10, monitor_frames=2, cam_mhz=12.5, scene="match:7", match=dict(t_max=40),
               timing=dict(h_blank=64, v_sync=2, v_back=4, v_front=2))
 MARKERS = ("<!-- boardsim:begin -->", "<!-- boardsim:end -->")
 

@@ -20,7 +20,9 @@ import numpy as np
 from eyestereo.tools.board.regmap import BOARD_BASE, BOARD_ID, BOARD_REGMAP
 from eyestereo.tools.host_driver import BusError, HostDriver
 from eyestereo.tools.models.feature_list import MARKER
-from eyestereo.tools.models.sram_arbiter import AddressMap, list_words
+from eyestereo.tools.models.match_engine import MARKER as MATCH_MARKER
+from eyestereo.tools.models.match_engine import parse_list
+from eyestereo.tools.models.sram_arbiter import AddressMap, list_words, match_offset
 from eyestereo.tools.regmap import REGMAP
 
 __all__ = ["OffsetBus", "Board", "Pair"]
@@ -51,6 +53,9 @@ class Pair:
     features: list[tuple[int, int, int]]  # (x, y, camera)
     overflow: bool
     frame: int  # FRAMES when it was taken
+    #: the frame's match list (a board built with the matcher, ``take_pair(matches=True)``): (x, y, disparity,
+    #: cost, dy) per match, the left corner's x and y; None when not read
+    matches: list[tuple[int, int, int, int, int]] | None = None
 
 
 class Board:
@@ -95,16 +100,19 @@ class Board:
             await self.bus.wait(poll_clocks)
             waited += poll_clocks
 
-    async def take_pair(self, *, max_features: int = 1023, timeout_clocks: int = 100_000_000,
-                        poll_clocks: int = 10_000) -> Pair:
+    async def take_pair(self, *, max_features: int = 1023, matches: bool = False, max_matches: int = 1023,
+                        timeout_clocks: int = 100_000_000, poll_clocks: int = 10_000) -> Pair:
         """The newest rectified pair and its feature list (the display stopped meanwhile and restarted after;
-        TimeoutError when no pair comes: the cameras stopped, or the front end is not running)."""
+        TimeoutError when no pair comes: the cameras stopped, or the front end is not running). ``matches``: the
+        board was built with the matcher (``ulx3s(matcher=True)``: its list buffers hold ``max_matches`` matches
+        after the features, so they lie elsewhere): the frame's match list is read too (:attr:`Pair.matches`)."""
         run = await self.regs.get("display_run")
         await self.set_display(False)
         try:
             await self.wait_display_idle()
             width, height = await self.geometry()
-            amap = AddressMap(width, height, list_words(max_features), cameras=False)
+            amap = AddressMap(width, height, list_words(max_features, max_matches if matches else None),
+                              cameras=False)
             await self.fe.set(rect_want=1, feat_want=1)
             waited = 0
             while True:
@@ -120,12 +128,36 @@ class Board:
             words = await self.fe.read_sram_words(amap.rectified(st["rect_buf"]), width * height)
             pix = np.asarray(words, dtype=np.uint16).reshape(height, width)
             feats, overflow = await self._feature_list(amap.features(st["feat_buf"]), max_features)
+            found = None
+            if matches:
+                found = await self._match_list(amap.features(st["feat_buf"]) + match_offset(max_features),
+                                               max_matches)
             await self.fe.pulse("rect_release", "feat_release")
             await self.fe.set(rect_want=0, feat_want=0)
         finally:
             await self.set_display(bool(run))
         return Pair(left=(pix & 0xFF).astype(np.uint8), right=(pix >> 8).astype(np.uint8), features=feats,
-                    overflow=overflow, frame=frame)
+                    overflow=overflow, frame=frame, matches=found)
+
+    async def _match_list(self, base: int, max_matches: int, *, chunk: int = 63) -> list[tuple[int, int, int, int,
+                                                                                           int]]:
+        """The match list's matches (x, y, disparity, cost, dy), read ``chunk`` words (whole matches) at a time up
+        to its trailer; BusError when the words are not a list."""
+        limit = 3 * max_matches + 3
+        words: list[int] = []
+        while len(words) < limit:
+            got = await self.fe.read_sram_words(base + len(words), min(chunk, limit - len(words)))
+            for i in range(len(words) - len(words) % 3, len(words) + len(got) - 2, 3):
+                trip = (words + got)[i:i + 3]
+                if trip[0] == MATCH_MARKER:
+                    try:
+                        lst = parse_list((words + got)[:i + 3])
+                    except ValueError as e:
+                        raise BusError(f"the match list at SRAM word {base}: {e}") from None
+                    return [(int(x), int(y), int(d), int(c), int(dy)) for (x, y, d, c), dy in
+                            zip(lst["matches"], lst["dy"])]
+            words += got
+        raise BusError(f"no match list trailer within {max_matches} matches at SRAM word {base}")
 
     async def _feature_list(self, base: int, max_features: int, *, chunk: int = 64) -> tuple[list[tuple[int, int, int]],
                                                                                             bool]:

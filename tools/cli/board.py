@@ -4,7 +4,7 @@
 
     eyestereo board status  --port /dev/ttyUSB0 [--json]            both register maps' status, the clocks
     eyestereo board set     --port P [--k-left N] [--k-right N] [--thr-left C,..] [--thr-right C,..] [--display on|off]
-    eyestereo board grab    --port P -o DIR                          left.png, right.png, marked.png, features.json
+    eyestereo board grab    --port P -o DIR [--matches]              left.png, right.png, marked.png, features.json
     eyestereo board adapt   --port P --target N [--frames K]         the adaptive threshold loop (secant controller)
     eyestereo board program [--bit FILE] [--cable NAME]              load a bitstream with openFPGALoader
 
@@ -106,7 +106,7 @@ def cmd_grab(args) -> int:
 
     with Outputs() as out:
         folder = out.folder(args.output, owned={"left.png", "right.png", "marked.png", "features.json"})
-        pair = _with_board(args, lambda b: b.take_pair())
+        pair = _with_board(args, lambda b: b.take_pair(matches=args.matches))
         ram_l, ram_r = copy_pair(pair.left, pair.right, pair.features)
         marked = np.concatenate([np.where(r[..., None] == 255, np.array([0, 0, 255], np.uint8),
                                           np.repeat(r[..., None], 3, axis=2)) for r in (ram_l, ram_r)], axis=1)
@@ -115,8 +115,11 @@ def cmd_grab(args) -> int:
                 raise ValueError(f"cannot write {name}")
         (folder / "features.json").write_text(json.dumps(dict(
             frame=pair.frame, overflow=pair.overflow, width=int(pair.left.shape[1]), height=int(pair.left.shape[0]),
-            features=[dict(x=x, y=y, camera="right" if c else "left") for x, y, c in pair.features]), indent=1))
-    print(f"{args.output}: {len(pair.features)} features of frame {pair.frame}")
+            features=[dict(x=x, y=y, camera="right" if c else "left") for x, y, c in pair.features],
+            **({} if pair.matches is None else dict(matches=[dict(x=x, y=y, disparity=d, cost=c, dy=dy)
+                                                             for x, y, d, c, dy in pair.matches]))), indent=1))
+    more = "" if pair.matches is None else f" and {len(pair.matches)} matches"
+    print(f"{args.output}: {len(pair.features)} features{more} of frame {pair.frame}")
     return 0
 
 
@@ -177,6 +180,8 @@ def register(subparsers: Any) -> None:
     p = sub.add_parser("grab", help="the newest rectified pair and its features to PNG and JSON")
     _port_args(p)
     p.add_argument("-o", "--output", type=Path, required=True, help="folder to write (created or replaced)")
+    p.add_argument("--matches", action="store_true",
+                   help="the bitstream has the hardware matcher (--matcher): read the match list too")
     p.set_defaults(func=cmd_grab)
     p = sub.add_parser("adapt", help="the adaptive threshold loop on the board (secant controller, thesis 7.2)")
     _port_args(p)
