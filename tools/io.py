@@ -55,6 +55,7 @@ __all__ = [
     "dir_mode",
     "file_mode",
     "read_image",
+    "revision",
     "to_grey8",
     "user_text",
     "write_section",
@@ -221,6 +222,23 @@ def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
     with atomic_output(path) as tmp:
         with open(tmp, "w", encoding="utf-8", newline="\n") as fh:
             fh.write(text)
+
+
+def revision(paths=("hdl",)) -> str:
+    """The commit a measurement belongs to: git's short HEAD of this checkout, with ``+`` when ``paths`` (the
+    measured sources; default the HDL) differ from it; ``unknown`` outside a git checkout."""
+    import subprocess
+
+    root = Path(__file__).resolve().parents[1]
+
+    def git(*a):
+        try:
+            return subprocess.run(["git", *a], cwd=root, capture_output=True, text=True).stdout.strip()
+        except OSError:
+            return ""
+
+    rev = git("rev-parse", "--short", "HEAD") or "unknown"
+    return rev + ("+" if rev != "unknown" and git("status", "--porcelain", "--", *paths) else "")
 
 
 def write_section(doc: str | os.PathLike[str], text: str, begin: str, end: str) -> None:

@@ -10,12 +10,12 @@ Steps, in ``<out>/`` (default ``build/board/<board>``):
    and one clock constraint, the oscillator's, raised by :data:`MARGIN` (10 %): nextpnr derives every PLL output's
    constraint from it, so each clock is placed and routed for its frequency plus the margin; the cameras' PCLK
    inputs likewise (their 25 MHz plus the margin).
-3. Yosys ``synth_ecp5`` (with the flip-flops moved into the multipliers' and block RAMs' registers, as
-   ``make synth`` does), then nextpnr-ecp5 for the board's device (with ``make synth``'s placer options) with each
-   seed of ``--seeds`` (default 1),
-   **without** ``--timing-allow-fail``: a seed that misses a constraint fails; the first seed that meets all is
-   packed by ``ecppack`` into ``<board>.bit``. Every seed's report is kept (``pnr_report_seed<N>.json``) and the
-   summary (``bitstream.json``: utilisation, fmax per clock and seed, the times) is what docs/boards.md shows.
+3. Yosys ``synth_ecp5`` (the memories named ``_norw`` marked ``no_rw_check``, and the flip-flops moved into the
+   multipliers' and block RAMs' registers, as ``make synth`` does), then nextpnr-ecp5 for the board's device
+   (with ``make synth``'s placer options) with each seed of ``--seeds`` (default 1), **without**
+   ``--timing-allow-fail``: a seed that misses a constraint fails; the first seed that meets all is packed by
+   ``ecppack`` into ``<board>.bit``. Every seed's report is kept (``pnr_report_seed<N>.json``) and the summary
+   (``bitstream.json``: utilisation, fmax per clock and seed, the times) is what docs/boards.md shows.
 
 Bad input (an unknown board, a camera mapping that does not parse, a tool missing) is a one-line error and exit
 status 1; a failed run leaves no ``.bit``.
@@ -40,10 +40,11 @@ from eyestereo.hdl.boards.ulx3s import CLOCKS, ulx3s
 from eyestereo.hdl.flow.bram_regs import pack_bram_registers
 from eyestereo.hdl.flow.convert import fresh_names
 from eyestereo.hdl.flow.dsp_regs import pack_file
+from eyestereo.hdl.flow.netlist import mark_no_rw_check
 from eyestereo.hdl.flow.synth import NEXTPNR_OPTS, nextpnr_command, tool, yosys
 from eyestereo.hdl.interfaces.camera_bus import CameraBus
 from eyestereo.tools.board import ulx3s as board_pins
-from eyestereo.tools.io import write_section
+from eyestereo.tools.io import revision, write_section
 
 __all__ = ["BOARDS", "HASH_SEED", "MARGIN", "board_ports", "build", "convert_reproducibly", "main"]
 
@@ -157,6 +158,7 @@ def build(board: str, out: Path, *, seeds=(1,), mapping=None, **params) -> dict:
     t0 = time.perf_counter()
     v = convert_reproducibly(out, **params)
     text, dropped = drop_zero_memory_init(v.read_text())
+    text, norw = mark_no_rw_check(text)
     v.write_text(text)
     t_conv = time.perf_counter() - t0
     yosys(f"read_verilog {v.name}; synth_ecp5 -top ulx3s -json ulx3s.json", out, "yosys.log")
@@ -185,8 +187,9 @@ def build(board: str, out: Path, *, seeds=(1,), mapping=None, **params) -> dict:
         if r.returncode == 0 and chosen is None:
             chosen = seed
     summary = dict(board=board, params={k: str(v) for k, v in params.items()}, seeds=list(seeds), runs=runs,
-                   clocks=clocks, margin=MARGIN, memory_inits_dropped=dropped, dsp_regs=dsp, bram_regs=bram,
-                   chosen_seed=chosen,
+                   clocks=clocks, margin=MARGIN, memory_inits_dropped=dropped, no_rw_check=norw, dsp_regs=dsp,
+                   bram_regs=bram,
+                   chosen_seed=chosen, revision=revision(("hdl", "tools")),
                    seconds=dict(convert=round(t_conv, 1), yosys=round(t_syn, 1)))
     if chosen is not None:
         t2 = time.perf_counter()
@@ -217,8 +220,10 @@ def doc_section(s: dict) -> str:
     nets = sorted({_net(c) for r in runs for c in r["fmax"]}, key=lambda n: list(CLOCK_NAMES).index(n)
                   if n in CLOCK_NAMES else 99)
     seeds = [r["seed"] for r in runs]
+    params = "".join(f", {k}={v}" for k, v in s.get("params", {}).items() if k != "mapping")
     lines = [f"Measured by `python -m eyestereo.hdl.flow.bitstream --seeds {','.join(map(str, seeds))} --doc "
-             f"docs/boards.md` ({s['board']}, the netlist of the bitstream: MyHDL's Verilog of the board top, Yosys "
+             f"docs/boards.md` ({s['board']}{params}, the board top of commit {s.get('revision', 'unknown')}; "
+             "the netlist of the bitstream: MyHDL's Verilog of the board top, Yosys "
              "`synth_ecp5`, nextpnr-ecp5 with the board's LPF; every clock constrained "
              f"{round((s['margin'] - 1) * 100)} % above its frequency, so a clock that meets its constraint has the "
              "margin).", "",

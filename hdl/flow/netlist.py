@@ -121,13 +121,16 @@ def fix_arithmetic_shifts(verilog: str) -> tuple[str, int]:
     return _ASR.subn(r"\1 >>> ", verilog)
 
 
-_NORW = re.compile(r"^(\s*)(reg \[\d+:\d+\] \w+_norw\[\d+:\d+\]\s*;)", re.M)
+#: A memory's declaration whose name ends in ``_norw``: GHDL's netlist (``reg [7:0] x_norw[2047:0] ;``) and MyHDL's
+#: Verilog (``reg [7:0] x_norw [0:2048-1];``, a 1-bit memory without the width), which the board flow reads.
+_NORW = re.compile(r"^(\s*)(reg (?:\[\d+:\d+\] )?\w+_norw ?\[[\d+:\- ]+\]\s*;)", re.M)
 
 
 def mark_no_rw_check(verilog: str) -> tuple[str, int]:
     """``(* no_rw_check *)`` on every memory whose MyHDL name ends in ``_norw``: a block promises by that name that
-    it never reads an address in the clock it writes it (hdl/rectify/line_cache.py), so Yosys need not build the
-    logic that emulates such a collision between a block RAM's two ports (a LUT between the RAM and its register)."""
+    it never reads an address in the clock it writes it (hdl/rectify/line_cache.py) or never uses such a read, so
+    Yosys need not build the logic that emulates such a collision between a block RAM's two ports (a LUT between
+    the RAM and its register)."""
     return _NORW.subn(r"\1(* no_rw_check *) \2", verilog)
 
 

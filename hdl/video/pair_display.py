@@ -49,15 +49,20 @@ PLANE_LATENCY = 4
 @block
 def pd_bank(clk, we, waddr, wval, raddr, q, *, depth: int):
     """One bank of a mark plane: a ``depth`` x 1 RAM, written at ``waddr`` when ``we``, read at ``raddr`` into a
-    register and a second one (the block RAM's own output register: the bank's bit leaves at a flip-flop)."""
-    mem = [Signal(bool(0)) for _ in range(depth)]
+    register and a second one (the block RAM's own output register: the bank's bit leaves at a flip-flop).
+
+    The display never uses a read of an address in the clock it writes it (a pixel's bit is cleared in the clock
+    the pixel is written, and the next bit it uses is read :data:`PLANE_LATENCY` clocks later; the crosses are
+    drawn before the pixel phase reads): the memory is named ``_norw``, so Yosys builds no collision logic between
+    the RAM and its register, and the board flow moves that register into the block RAM."""
+    mem_norw = [Signal(bool(0)) for _ in range(depth)]
     rd = Signal(bool(0))
 
     @always(clk.posedge)
     def ram():
         if we:
-            mem[int(waddr)].next = wval
-        rd.next = mem[int(raddr)]
+            mem_norw[int(waddr)].next = wval
+        rd.next = mem_norw[int(raddr)]
 
     @always(clk.posedge)
     def out():

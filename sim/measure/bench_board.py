@@ -18,7 +18,7 @@ from pathlib import Path
 import eyestereo.sim.harnesses.board_harness  # noqa: F401  (registers the bench top)
 from eyestereo.hdl.boards.ulx3s import CLOCKS
 from eyestereo.sim.lib.runner import run_bench
-from eyestereo.tools.io import write_section
+from eyestereo.tools.io import revision, write_section
 
 #: The run of tests/boards/test_board_sim.py (kept equal by tests/boards/test_board_sim.py importing them).
 PARAMS = dict(quantizers="rig:32x24", mode="sim-64x48", clocks_per_bit=8, sccb_table=((0x11, 0x00), (0x40, 0xD0)),
@@ -26,16 +26,6 @@ PARAMS = dict(quantizers="rig:32x24", mode="sim-64x48", clocks_per_bit=8, sccb_t
 CONFIG = dict(frames=400, target=12, k=10, monitor_frames=2, cam_mhz=12.5, scene="match:7", match=dict(t_max=40),
               timing=dict(h_blank=64, v_sync=2, v_back=4, v_front=2))
 MARKERS = ("<!-- boardsim:begin -->", "<!-- boardsim:end -->")
-
-
-def revision() -> str:
-    """The commit the measured HDL belongs to (``+`` when the tree differs from it)."""
-    import subprocess
-
-    root = Path(__file__).resolve().parents[2]
-    run = lambda *a: subprocess.run(["git", *a], cwd=root, capture_output=True, text=True)  # noqa: E731
-    rev = run("rev-parse", "--short", "HEAD").stdout.strip() or "unknown"
-    return rev + ("+" if run("status", "--porcelain", "hdl").stdout.strip() else "")
 
 
 def section(rep: dict, sim: str, wall: float) -> str:

@@ -163,3 +163,9 @@ def test_norw_memories_are_marked_for_yosys():
     out, n = mark_no_rw_check(text)
     assert n == 1
     assert "(* no_rw_check *) reg [7:0] a_bank0_mem_norw[2047:0] ;" in out and "\n  reg [7:0] fifo_mem[15:0]" in out
+    # MyHDL's own Verilog (the board flow's input): a space before the range, a 1-bit memory without a width
+    text = ("reg [7:0] lc_bank0_mem_norw [0:2048-1];\nreg pd_bank0_mem_norw [0:16384-1];\n"
+            "reg [17:0] fifo_mem [0:32-1];\nreg norw_flag;\n")
+    out, n = mark_no_rw_check(text)
+    assert n == 2 and out.count("(* no_rw_check *)") == 2
+    assert "(* no_rw_check *) reg pd_bank0_mem_norw [0:16384-1];" in out and "\nreg [17:0] fifo_mem [0:32-1];" in out
