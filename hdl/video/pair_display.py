@@ -20,8 +20,9 @@ from eyestereo.tools.regmap import REGMAP
 
 __all__ = ["pair_display", "MARK_DRAIN", "PLANE_BANK", "PLANE_LATENCY"]
 
-#: Clocks the mark pipeline (coordinates, address) needs to drain after a cross's last pixel.
-MARK_DRAIN = 2
+#: Clocks the mark pipeline (coordinates, address, the plane's write register) needs to drain after a cross's
+#: last pixel.
+MARK_DRAIN = 3
 
 
 @block
@@ -75,18 +76,25 @@ def pd_bank(clk, we, waddr, wval, raddr, q, *, depth: int):
 def pd_plane(clk, we, waddr, wval, raddr, q, *, depth: int):
     """A ``depth`` x 1 mark plane in banks of :data:`PLANE_BANK` (one block RAM each), read in three clocks
     (the display's address register makes :data:`PLANE_LATENCY`): each bank's bit from its output register, then
-    the bank chosen into ``q``. A
+    the bank chosen into ``q``; written a clock after ``we`` (the bank's write enable, address and bit from
+    registers: the display's state decoded straight into the banks' enables, spread over the block-RAM columns,
+    was the matcher build's slowest path). A
     single memory of 76,800 bits put the multiplexer of its block RAMs between their outputs and the next
     flip-flop: that path was the memory clock's slowest on the board (12.9 ns)."""
     banks = (depth + PLANE_BANK - 1) // PLANE_BANK
     if banks == 1:
         one = Signal(bool(0))
+        we1, wval1 = Signal(bool(0)), Signal(bool(0))
+        waddr1 = Signal(intbv(0)[len(waddr):])
 
         @always(clk.posedge)
         def last():
+            we1.next = we
+            waddr1.next = waddr
+            wval1.next = wval
             q.next = one
 
-        return pd_bank(clk, we, waddr, wval, raddr, one, depth=depth), last
+        return pd_bank(clk, we1, waddr1, wval1, raddr, one, depth=depth), last
     abits = len(waddr)
     lo = PLANE_BANK.bit_length() - 1
     sbits = abits - lo
@@ -95,20 +103,23 @@ def pd_plane(clk, we, waddr, wval, raddr, q, *, depth: int):
     we_vec = Signal(intbv(0)[banks:])
     w_lo, r_lo = Signal(intbv(0)[lo:]), Signal(intbv(0)[lo:])
     w_hi = Signal(intbv(0)[sbits:])
+    wval1 = Signal(bool(0))
     r_sel0, r_sel1 = Signal(intbv(0)[sbits:]), Signal(intbv(0)[sbits:])  # the read's bank, delayed with it
-    insts = [pd_bank(clk, we_vec(b), w_lo, wval, r_lo, bank_q[b], depth=PLANE_BANK) for b in range(banks)]
+    insts = [pd_bank(clk, we_vec(b), w_lo, wval1, r_lo, bank_q[b], depth=PLANE_BANK) for b in range(banks)]
 
     @always_comb
     def split():
-        w_lo.next = waddr[lo:0]
         r_lo.next = raddr[lo:0]
         w_hi.next = waddr[abits:lo]
 
-    @always_comb
+    @always(clk.posedge)
     def decode():
+        # the write a clock later, from registers: each bank's enable, the address in the bank, the bit
         we_vec.next = 0
         if we:
             we_vec.next[int(w_hi)] = 1
+        w_lo.next = waddr[lo:0]
+        wval1.next = wval
 
     @always(clk.posedge)
     def select():

@@ -164,3 +164,49 @@ def test_the_board_netlist_is_the_same_on_every_run(tmp_path):
                        env=dict(os.environ, PYTHONHASHSEED=other))
     assert r.returncode == 0, r.stderr[-2000:]
     assert _body(a) == _body(tmp_path / "b" / "ulx3s.v")
+
+
+class _SramBus:
+    """A bus with the register map's SRAM window over a dict of words (absent words read 0), counting bursts."""
+
+    def __init__(self, words: dict[int, int]):
+        from eyestereo.tools.regmap import REGMAP
+
+        self.words, self.base, self.bursts = words, REGMAP["SRAM"].offset, []
+
+    async def read_burst(self, address, count):
+        first = (address - self.base) // 4
+        self.bursts.append((first, count))
+        return [(self.words.get(first + i, 0), 0) for i in range(count)]
+
+
+def test_the_host_reads_a_match_list_in_whole_matches():
+    """Board._match_list: chunks of whole matches up to the trailer (not the whole buffer), the matches unpacked
+    with MATCH's fields; a buffer without a trailer or with a wrong count is a BusError that names it."""
+    import asyncio
+
+    from eyestereo.tools.board.host import Board
+    from eyestereo.tools.host_driver import BusError
+    from eyestereo.tools.models.match_engine import MARKER, MATCH, TRAILER
+
+    matches = [(10 + i, 3 + i, i % 7, 100 + i, (i % 3) - 1) for i in range(30)]  # x, y, d, cost, dy
+
+    def put(words, base, ms, count):
+        for i, (x, y, d, c, dy) in enumerate(ms):
+            v = int(MATCH.pack(x=x, y=y, disparity=d, cost=c, dy=dy))
+            words.update({base + 3 * i + j: (v >> 16 * j) & 0xFFFF for j in range(3)})
+        t = int(TRAILER.pack(marker=MARKER, count=count, overflow=0, candidates=77))
+        words.update({base + 3 * len(ms) + j: (t >> 16 * j) & 0xFFFF for j in range(3)})
+
+    words: dict[int, int] = {}
+    put(words, 5000, matches, len(matches))
+    bus = _SramBus(words)
+    got = asyncio.run(Board(bus)._match_list(5000, 1023))
+    assert got == matches
+    assert bus.bursts == [(5000, 63), (5063, 63)]  # 31 triples: two chunks of 21 matches, not 1023 matches' words
+    with pytest.raises(BusError, match="no match list trailer within 4 matches at SRAM word 9000"):
+        asyncio.run(Board(_SramBus({}))._match_list(9000, 4))
+    bad: dict[int, int] = {}
+    put(bad, 100, matches[:2], 3)
+    with pytest.raises(BusError, match="the match list at SRAM word 100: match list of 2 matches, its trailer counts 3"):
+        asyncio.run(Board(_SramBus(bad))._match_list(100, 1023))
