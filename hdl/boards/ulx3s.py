@@ -28,7 +28,7 @@ from eyestereo.tools.ov7670 import TABLE as OV7670_TABLE
 from eyestereo.tools.regmap import REGMAP
 from eyestereo.tools.sdram import ULX3S
 
-__all__ = ["ulx3s", "CLOCKS", "SDRAM_CLOCK"]
+__all__ = ["ulx3s", "board_clocks", "BAUD", "CLOCKS", "MATCHER_MEMORY_MHZ", "SDRAM_CLOCK"]
 
 #: The board's clocks (MHz): the oscillator and the PLL's four outputs in its order (CLKOP, CLKOS, CLKOS2, CLKOS3).
 #: The memory clock is 75 MHz, not the front end's usual 100: the stream front end's slowest path (the rectifier's
@@ -36,6 +36,21 @@ __all__ = ["ulx3s", "CLOCKS", "SDRAM_CLOCK"]
 #: project's 10 % margin while QVGA cameras at 30 frames/s need a small part of it. 75, 125, 50 and 25 divide one
 #: VCO (750 MHz) exactly.
 CLOCKS = dict(osc=25.0, mem=75.0, tmds=125.0, harris=50.0, pixel=25.0)
+#: The memory clock with the hardware matcher (``matcher=True``): its corner rings' handshake (match_engine's sink
+#: side, spread over the block-RAM columns beside the rest of the board) reached 72-87 MHz over nextpnr's seeds
+#: 1-4 at 75 MHz; 62.5 MHz (the same VCO / 12) keeps the 10 % margin. The cameras' QVGA still leaves about 24
+#: memory clocks a pixel.
+MATCHER_MEMORY_MHZ = 62.5
+#: The serial link's baud rate the default ``clocks_per_bit`` aims at: the FT231X's fastest standard rate.
+BAUD = 3_000_000
+
+
+def board_clocks(*, matcher: bool = False, memory_mhz: float | None = None) -> dict:
+    """The clocks (MHz) of a board top built with ``matcher`` and ``memory_mhz`` (None: 75, or
+    :data:`MATCHER_MEMORY_MHZ` with the matcher): :data:`CLOCKS` with that memory clock."""
+    if memory_mhz is None:
+        memory_mhz = MATCHER_MEMORY_MHZ if matcher else CLOCKS["mem"]
+    return dict(CLOCKS, mem=float(memory_mhz))
 #: How the SDRAM's clock pin is driven from the memory clock (an ODDRX1F): "same" (the memory clock's phase, the
 #: timing the SDRAM controller and its model were verified with: docs/sdram.md) or "inverted" (the part samples
 #: the commands half a clock after the FPGA launched them; for a board whose I/O delays need it).
@@ -67,15 +82,16 @@ def rs_sync(clk, arst, rst, *, stages: int = 3):
 def ulx3s(clk_25mhz, led, btn, ftdi_txd, ftdi_rxd, sdram_clk, sdram_cke, sdram_csn, sdram_wen, sdram_rasn,
           sdram_casn, sdram_a, sdram_ba, sdram_dqm, sdram_d, gpdi_dp, cam_l, cam_l_xclk, cam_l_sioc, cam_l_siod,
           cam_l_resetn, cam_l_pwdn, cam_r, cam_r_xclk, cam_r_sioc, cam_r_siod, cam_r_resetn, cam_r_pwdn, *,
-          quantizers="rig:320x240", mode: str = "640x480@60", clocks_per_bit: int = 25,
+          quantizers="rig:320x240", mode: str = "640x480@60", clocks_per_bit: int | None = None,
           sccb_table=OV7670_TABLE, sccb_hz: float = 100e3, sdram_clock: str = "same", order: str = "YUYV",
-          matcher: bool = False, match_rows: int = 1, reset_hold: int = 3):
+          matcher: bool = False, match_rows: int = 1, memory_mhz: float | None = None, reset_hold: int = 3):
     """The board top: the stereo front end with ``memory="sdram"`` and ``rectify="stream"`` on the ULX3S, the cameras
     configured over SCCB at start, the newest rectified pair and its corners on the HDMI monitor, the register map
     on the USB serial port (docs/boards.md: wiring, building, programming, the host tool).
 
     Clocks: one EHXPLLL (:func:`~eyestereo.hdl.boards.ecp5.ecp5_pll`, :func:`eyestereo.tools.board.ecp5_pll.plan`)
-    makes :data:`CLOCKS` from the 25 MHz oscillator: memory 75 MHz (SDRAM, front end, bridge, display's copy, SCCB),
+    makes :func:`board_clocks` from the 25 MHz oscillator: memory 75 MHz (62.5 with the matcher; SDRAM, front end,
+    bridge, display's copy, SCCB),
     TMDS 125 MHz (two bits a clock through ODDRX1F cells), Harris 50 MHz, pixel 25 MHz (the monitor; also the
     cameras' XCLK). Each domain's reset is held while the PLL is unlocked (a synchroniser each); each camera's PCLK
     domain likewise. The cameras are held in reset (RESET low) until the memory clock's reset ends.
@@ -92,7 +108,8 @@ def ulx3s(clk_25mhz, led, btn, ftdi_txd, ftdi_rxd, sdram_clk, sdram_cke, sdram_c
             pair copied to the monitor, 5 a serial-link error seen, 6 blinks (1 Hz, pixel clock alive), 7 display
             running.
         btn (7): btn[1] (FIRE1) writes the cameras' table again; btn[2] (FIRE2) held freezes the picture.
-        ftdi_txd, ftdi_rxd: the FT231X's serial lines (the FPGA receives on txd), 8N1 at 100 MHz / clocks_per_bit.
+        ftdi_txd, ftdi_rxd: the FT231X's serial lines (the FPGA receives on txd), 8N1 at the memory clock /
+            ``clocks_per_bit``.
         sdram_*: the SDRAM (sdram_d bidirectional).
         gpdi_dp (4): TMDS blue, green, red, clock (LVCMOS33D pairs).
         cam_l, cam_r: :class:`~eyestereo.hdl.interfaces.camera_bus.CameraBus` (PCLK, VSYNC, HREF, data), the
@@ -103,8 +120,9 @@ def ulx3s(clk_25mhz, led, btn, ftdi_txd, ftdi_rxd, sdram_clk, sdram_cke, sdram_c
         quantizers: the rig's calibration (as the front end's); its size is the cameras' (320 x 240: the OV7670's
             QVGA, :data:`eyestereo.tools.ov7670.TABLE`), and two images side by side must fit ``mode``.
         mode: the monitor's video mode (:data:`eyestereo.tools.models.video_timing.MODES`).
-        clocks_per_bit: the serial link's bit time in memory clocks (25: 3 Mbaud, the FT231X's fastest standard
-            rate; 651: 115,200 baud).
+        clocks_per_bit: the serial link's bit time in memory clocks (default: the nearest to :data:`BAUD`, 3 Mbaud,
+            the FT231X's fastest standard rate: 25 at 75 MHz, 21 at 62.5 MHz (2.976 Mbaud, 0.8 % slow, well inside
+            a UART's tolerance); 651 at 75 MHz: 115,200 baud).
         sccb_table: the cameras' register table ((register, value) pairs; :mod:`eyestereo.tools.ov7670`).
         sccb_hz: the SCCB clock (at most 400 kHz).
         sdram_clock: :data:`SDRAM_CLOCK`.
@@ -114,6 +132,8 @@ def ulx3s(clk_25mhz, led, btn, ftdi_txd, ftdi_rxd, sdram_clk, sdram_cke, sdram_c
             :func:`~eyestereo.hdl.video.pair_display.pair_display`).
         match_rows: with ``matcher``, the rows searched above and below a left corner's (0..7; default 1: a rig's
             rectification seldom lines its rows up to the pixel; the front end's own default is 0).
+        memory_mhz: the memory clock (MHz; None: 75, or :data:`MATCHER_MEMORY_MHZ` with ``matcher``); the PLL
+            planner must reach it from the VCO that gives the other three clocks.
         reset_hold: flip-flops of each reset synchroniser (2..8).
 
     Latency: the picture shows a pair about a monitor frame after the front end finished it (the copy starts
@@ -136,7 +156,13 @@ def ulx3s(clk_25mhz, led, btn, ftdi_txd, ftdi_rxd, sdram_clk, sdram_cke, sdram_c
         if len(port) != w:
             raise block_error(f"port {name} must be {w} bits, got {len(port)}")
 
-    plan = pll_plan(CLOCKS["osc"], (CLOCKS["mem"], CLOCKS["tmds"], CLOCKS["harris"], CLOCKS["pixel"]))
+    ck = board_clocks(matcher=matcher, memory_mhz=memory_mhz)
+    if clocks_per_bit is None:
+        clocks_per_bit = round(ck["mem"] * 1e6 / BAUD)
+    try:
+        plan = pll_plan(ck["osc"], (ck["mem"], ck["tmds"], ck["harris"], ck["pixel"]))
+    except ValueError as e:
+        raise block_error(f"parameter memory_mhz={memory_mhz!r}: {e}") from None
     insts = []
 
     # ---- clocks and resets ------------------------------------------------------------------------
@@ -161,7 +187,7 @@ def ulx3s(clk_25mhz, led, btn, ftdi_txd, ftdi_rxd, sdram_clk, sdram_cke, sdram_c
     sdram = SdramPins(ULX3S)
     amap = AddressMap(width, height, list_words(1023, 1023 if matcher else None), cameras=False)
     insts.append(stereo_frontend(mclk, rst_m, hclk, rst_h, cam_l, wrst_l, cam_r, wrst_r, fe_bus, sdram,
-                                 quantizers=cal, memory="sdram", sdram_part=ULX3S, memory_mhz=CLOCKS["mem"],
+                                 quantizers=cal, memory="sdram", sdram_part=ULX3S, memory_mhz=ck["mem"],
                                  rectify="stream", order=order,
                                  matcher=matcher, match_rows=match_rows, feature_words=amap.feature_words))
 
@@ -193,8 +219,8 @@ def ulx3s(clk_25mhz, led, btn, ftdi_txd, ftdi_rxd, sdram_clk, sdram_cke, sdram_c
     copies = Signal(intbv(0)[16:])
     insts.append(board_regs(mclk, rst_m, board_bus, display_run, sccb_restart, locked_m, sccb_busy, display_idle,
                             present, copies,
-                            uart_errors, mem_mhz=int(CLOCKS["mem"]), harris_mhz=int(CLOCKS["harris"]),
-                            pixel_mhz=int(CLOCKS["pixel"]), tmds_mhz=int(CLOCKS["tmds"])))
+                            uart_errors, mem_mhz=int(ck["mem"]), harris_mhz=int(ck["harris"]),
+                            pixel_mhz=int(ck["pixel"]), tmds_mhz=int(ck["tmds"])))
 
     # ---- buttons --------------------------------------------------------------------------------------
     f1a, f1b, f1c, f2a, f2b = (Signal(bool(0)) for _ in range(5))  # the buttons' synchronisers
@@ -254,7 +280,7 @@ def ulx3s(clk_25mhz, led, btn, ftdi_txd, ftdi_rxd, sdram_clk, sdram_cke, sdram_c
     sio_c, sio_d_oe = Signal(bool(1)), Signal(bool(0))
     sio_d_i = Signal(intbv(3)[2:])
     insts.append(sccb_master(mclk, rst_m, fire1, sio_c, sio_d_oe, sio_d_i, sccb_busy, sccb_done, present,
-                             table=sccb_table, clk_hz=CLOCKS["mem"] * 1e6, sccb_hz=sccb_hz, cameras=2))
+                             table=sccb_table, clk_hz=ck["mem"] * 1e6, sccb_hz=sccb_hz, cameras=2))
     siod_l, siod_r = Signal(bool(1)), Signal(bool(1))
 
     @always_comb
@@ -277,7 +303,7 @@ def ulx3s(clk_25mhz, led, btn, ftdi_txd, ftdi_rxd, sdram_clk, sdram_cke, sdram_c
               oddr(pclk, one, zero, cam_r_xclk, label="xclk_r_oddr")]
 
     # ---- LEDs --------------------------------------------------------------------------------------------
-    blink = Signal(intbv(0, min=0, max=int(CLOCKS["pixel"] * 1e6) // 2))
+    blink = Signal(intbv(0, min=0, max=int(ck["pixel"] * 1e6) // 2))
     beat = Signal(bool(0))
     seen_err = Signal(bool(0))
 

@@ -131,9 +131,9 @@ class BoardTB:
         self.mode = mode_of(p["mode"])
         self.mp = model_params({})
         self.timing = CameraTiming(width=self.w, height=self.h, **cfg.get("timing", {}))
-        from eyestereo.hdl.boards.ulx3s import CLOCKS
+        from eyestereo.hdl.boards.ulx3s import board_clocks
 
-        self.mem_mhz = CLOCKS["mem"]
+        self.mem_mhz = board_clocks(matcher=bool(p.get("matcher")), memory_mhz=p.get("memory_mhz"))["mem"]
         self.bit_ps = round(p["clocks_per_bit"] * 1e6 / self.mem_mhz)
 
     async def start(self, pair):

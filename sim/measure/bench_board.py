@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 
 import eyestereo.sim.harnesses.board_harness  # noqa: F401  (registers the bench top)
-from eyestereo.hdl.boards.ulx3s import CLOCKS
+from eyestereo.hdl.boards.ulx3s import board_clocks
 from eyestereo.sim.lib.runner import run_bench
 from eyestereo.tools.io import revision, write_section
 
@@ -30,18 +30,23 @@ MARKERS = ("<!-- boardsim:begin -->", "<!-- boardsim:end -->")
 
 def section(rep: dict, sim: str, wall: float) -> str:
     sim_ms = rep["sim_time_ns"] / 1e6
-    clocks = rep["sim_time_ns"] * CLOCKS["mem"] / 1e3
+    mem_mhz = board_clocks(matcher=PARAMS.get("matcher", False), memory_mhz=PARAMS.get("memory_mhz"))["mem"]
+    clocks = rep["sim_time_ns"] * mem_mhz / 1e3
     return "\n".join([
         f"Measured by `python -m eyestereo.sim.measure.bench_board` ({sim}; the board top of commit {revision()}, the small "
         "configuration above):", "",
         "| figure | value |", "|---|---:|",
         f"| features the host read over the serial line (= the model's) | {rep['features']} |",
+        f"| matches the host read (= the feature matcher model's); their segments' pixels on the monitor | "
+        f"{rep.get('matches')}; {rep.get('segment_pixels')} |",
         f"| threshold code (chosen with the model for about {CONFIG['target']} features per camera) | "
         f"{rep['threshold']} |",
         f"| FRAMES when the host took its pair | {rep['frames_at_grab']} |",
         f"| whole HDMI frames decoded (the last compared with the model's picture) | {rep['hdmi_frames']} |",
         f"| pairs the display copied | {rep['copies']} |",
         f"| requests on the serial line | {rep['requests']} |",
+        f"| DROPPED (left, right) after the run; FRAMES | {', '.join(map(str, rep['dropped']))}; {rep['frames']} |",
+        f"| memory clock | {mem_mhz:g} MHz |",
         f"| simulated time | {sim_ms:.2f} ms ({clocks / 1e3:.0f} k memory clocks) |",
         f"| wall time of the run | {wall:.0f} s ({clocks / wall / 1e3:.1f} k memory clocks/s) |", ""]) + "\n"
 
