@@ -96,7 +96,7 @@ def axil_arbiter(clk, rst, m0, m1, s, *, addr_bits=REGMAP.addr_bits):
     Resources: the address and data registers towards ``s`` (2 x (addr_bits + 3) + 36 flip-flops), the
     response registers (32 + 2 + 2), about 16 control flip-flops and the two-way multiplexers of the
     masters' payloads; default configuration (make synth's flow, Yosys xc3se): 141 LUT, 140 FF;
-    nextpnr-ecp5 262.9 MHz (seed 1, out of context).
+    nextpnr-ecp5 238.6 MHz (the slowest of seeds 1-4, out of context).
     """
     check_clock(clk)
     check_reset(rst)

@@ -86,7 +86,7 @@ def axil_split(clk, rst, m, s0, s1, *, split_bit=23):
     Resources: one address register (n + 3 flip-flops, the slaves share it), the write data (36) and
     response (36) registers, about 14 control flip-flops; no multiplexer on the request side, one on the
     slaves' responses; default configuration (make synth's flow, Yosys xc3se): 172 LUT, 111 FF;
-    nextpnr-ecp5 257.5 MHz (seed 1, out of context).
+    nextpnr-ecp5 257.5 MHz (the slowest of seeds 1-4, out of context).
     """
     check_clock(clk)
     check_reset(rst)

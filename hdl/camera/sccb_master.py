@@ -85,7 +85,7 @@ def sccb_master(clk, rst, start, sio_c, sio_d_oe, sio_d_i, busy, done, present, 
     Resources: a quarter counter, a millisecond counter, the table as a LUT ROM of 18-bit words
     (``kind``, reg, value), a handful of state registers; no block RAM, no multiplier. The OV7670 table,
     100 MHz, 100 kHz, 2 cameras (make synth's flow on this block alone): 191 LUT, 72 FF on the
-    Spartan-3E; 266 LUT4, 72 FF, 179.8 MHz on the ECP5 (nextpnr seed 1).
+    Spartan-3E; 266 LUT4, 72 FF, 178.2 MHz on the ECP5 (the slowest of nextpnr seeds 1-4).
     """
     check_clock(clk)
     check_reset(rst)

@@ -90,8 +90,8 @@ def uart_bridge(clk, rst, rx, tx, bus, errors, *, clocks_per_bit: int = DEFAULT_
     Resources: uart_rx, uart_tx, the FIFO (8 x ``fifo`` LUT-RAM bits), the 32-bit address shift register,
     address, data and reply registers, the timeout counter, the error counter. The catalogue's
     configuration (33 clocks per bit, 24 address bits, timeout 100,000, FIFO 16; make synth's flow,
-    Yosys xc3se): 423 LUT + 8 LUT-RAM, 280 FF, 0 RAMB16, 0 MULT; nextpnr-ecp5 134.2 MHz (seed 1), measured
-    before the request byte got its register (9 flip-flops more).
+    Yosys xc3se): 470 LUT + 8 LUT-RAM, 289 FF, 0 RAMB16, 0 MULT; nextpnr-ecp5 142.5 MHz (the slowest of seeds
+    1-4).
     """
     check_clock(clk)
     check_reset(rst)

@@ -66,7 +66,7 @@ def video_timing(clk, rst, hsync, vsync, de, x, y, line_start=None, frame_start=
     Latency: 1 clock from a counter state to the outputs (all outputs alike); x, y and de together.
 
     Resources: two counters (640x480: 10 + 10 bits), comparators with constants, the output flip-flops; 640x480
-    (make synth's flow, Yosys xc3se): 55 LUT, 44 FF; nextpnr-ecp5 197.5 MHz (goal 25).
+    (make synth's flow, Yosys xc3se): 55 LUT, 44 FF; nextpnr-ecp5 190.2 MHz (the slowest of seeds 1-4; goal 25).
     """
     check_clock(clk)
     check_reset(rst)
