@@ -224,21 +224,21 @@ def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
             fh.write(text)
 
 
-def revision(paths=("hdl",)) -> str:
+def revision(paths=("hdl", "tools/models")) -> str:
     """The commit a measurement belongs to: git's short HEAD of this checkout, with ``+`` when ``paths`` (the
-    measured sources; default the HDL) differ from it; ``unknown`` outside a git checkout."""
+    measured sources; default the HDL and its models) have uncommitted changes; ``?`` without git. The benches'
+    tables (``eyestereo.sim.lib.runner.hdl_revision``) and the bitstream summary both name their commit so."""
     import subprocess
 
     root = Path(__file__).resolve().parents[1]
-
-    def git(*a):
-        try:
-            return subprocess.run(["git", *a], cwd=root, capture_output=True, text=True).stdout.strip()
-        except OSError:
-            return ""
-
-    rev = git("rev-parse", "--short", "HEAD") or "unknown"
-    return rev + ("+" if rev != "unknown" and git("status", "--porcelain", "--", *paths) else "")
+    try:
+        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True,
+                              text=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--", *paths], cwd=root, capture_output=True,
+                               text=True).stdout.strip()
+    except OSError:
+        return "?"
+    return (head or "?") + ("+" if dirty else "")
 
 
 def write_section(doc: str | os.PathLike[str], text: str, begin: str, end: str) -> None:

@@ -33,6 +33,7 @@ from pathlib import Path
 from cocotb_tools.runner import get_results, get_runner
 
 from eyestereo.hdl.flow.convert import convert
+from eyestereo.tools.io import revision
 
 SIM_DIR = Path(__file__).resolve().parents[1]  # sim/ (the folder the benches' simulators get on PYTHONPATH)
 ROOT = SIM_DIR.parent
@@ -133,18 +134,9 @@ def hdl_revision() -> str:
     """The commit the HDL of a measurement was converted from, for the benches' tables.
 
     ``+`` follows it when ``hdl/`` or ``tools/models/`` has uncommitted changes (the measured HDL is then
-    not that commit's); ``?`` without git.
+    not that commit's); ``?`` without git (:func:`eyestereo.tools.io.revision`).
     """
-    import subprocess
-
-    try:
-        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                              text=True).stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain", "hdl", "tools/models"], cwd=ROOT,
-                               capture_output=True, text=True).stdout.strip()
-    except OSError:
-        return "?"
-    return (head or "?") + ("+" if dirty else "")
+    return revision(("hdl", "tools/models"))
 
 
 def archived_tree(rev: str, root: Path, *, cache: bool = False) -> Path:

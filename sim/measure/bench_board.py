@@ -17,8 +17,8 @@ from pathlib import Path
 
 import eyestereo.sim.harnesses.board_harness  # noqa: F401  (registers the bench top)
 from eyestereo.hdl.boards.ulx3s import board_clocks
-from eyestereo.sim.lib.runner import run_bench
-from eyestereo.tools.io import revision, write_section
+from eyestereo.sim.lib.runner import hdl_revision, run_bench
+from eyestereo.tools.io import write_section
 
 #: The run of tests/boards/test_board_sim.py (kept equal by tests/boards/test_board_sim.py importing them).
 PARAMS = dict(quantizers="rig:32x24", mode="sim-64x48", clocks_per_bit=8, sccb_table=((0x11, 0x00), (0x40, 0xD0)),
@@ -33,7 +33,7 @@ def section(rep: dict, sim: str, wall: float) -> str:
     mem_mhz = board_clocks(matcher=PARAMS.get("matcher", False), memory_mhz=PARAMS.get("memory_mhz"))["mem"]
     clocks = rep["sim_time_ns"] * mem_mhz / 1e3
     return "\n".join([
-        f"Measured by `python -m eyestereo.sim.measure.bench_board` ({sim}; the board top of commit {revision()}, the small "
+        f"Measured by `python -m eyestereo.sim.measure.bench_board` ({sim}; the board top of commit {hdl_revision()}, the small "
         "configuration above):", "",
         "| figure | value |", "|---|---:|",
         f"| features the host read over the serial line (= the model's) | {rep['features']} |",
